@@ -1,0 +1,246 @@
+//! The fixed-size payloads of every non-image topic.
+
+use crate::{Header, Message, ZeroCopySend};
+
+/// Sensors on the DRV's ring (001 §3: 24 Polaroid sensors).
+pub const SONAR_SENSORS: usize = 24;
+/// Sensors fired together in one bank (001 §3: 3 banks of 8).
+pub const SONAR_BANK_SIZE: usize = 8;
+/// Most features one detection message carries.
+pub const MAX_FEATURES: usize = 32;
+/// Most vertices of the uncertainty polygon.
+pub const MAX_POLYGON_VERTICES: usize = 32;
+
+macro_rules! message {
+    ($t:ty) => {
+        impl Message for $t {
+            fn header(&self) -> &Header {
+                &self.header
+            }
+        }
+    };
+}
+
+/// A planar pose: position in metres and heading in radians (counter-clockwise from +x).
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/Pose2")]
+pub struct Pose2 {
+    pub x_m: f64,
+    pub y_m: f64,
+    pub heading_rad: f64,
+}
+
+/// The simulator's true pose of the robot (`sim/truth`): for the renderer and for evaluation only.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/TruePose")]
+pub struct TruePose {
+    pub header: Header,
+    pub world_from_robot: Pose2,
+}
+message!(TruePose);
+
+/// One bank of sonar readings as the DRV reported them, converted to metres by the bridge.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/SonarRaw")]
+pub struct SonarRaw {
+    pub header: Header,
+    /// Which bank fired: 0, 1 or 2; sensor `bank + 3 * i` is `range_m[i]`.
+    pub bank: u32,
+    /// Bit i set: `range_m[i]` is an echo; clear: no echo within the sonar's limit.
+    pub echo_mask: u32,
+    pub range_m: [f32; SONAR_BANK_SIZE],
+}
+message!(SonarRaw);
+
+/// The whole ring, latest reading of each sensor with its geometry in the robot frame.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/SonarRing")]
+pub struct SonarRing {
+    pub header: Header,
+    pub range_m: [f32; SONAR_SENSORS],
+    /// Bearing of each sensor's axis in the robot frame.
+    pub bearing_rad: [f32; SONAR_SENSORS],
+    /// Stamp of each sensor's latest reading (0 = never read).
+    pub reading_stamp_ns: [u64; SONAR_SENSORS],
+    /// Bit i set: sensor i holds a valid echo.
+    pub valid_mask: u32,
+    /// Set when the panic-stop reflex fired on this ring.
+    pub panic_stop: u32,
+}
+message!(SonarRing);
+
+/// Shaft-encoder report as the DRV gives it (dead reckoning, not the truth), in SI units.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/EncodersRaw")]
+pub struct EncodersRaw {
+    pub header: Header,
+    pub x_m: f64,
+    pub y_m: f64,
+    pub heading_rad: f64,
+    /// 1 while the DRV executes a motion, 0 when idle.
+    pub moving: u32,
+    /// Id of the last command the DRV accepted.
+    pub command_id: u32,
+}
+message!(EncodersRaw);
+
+/// What a motion command asks for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum CommandKind {
+    Stop = 0,
+    Move = 1,
+    Turn = 2,
+    Velocity = 3,
+}
+
+impl CommandKind {
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        match raw {
+            0 => Some(Self::Stop),
+            1 => Some(Self::Move),
+            2 => Some(Self::Turn),
+            3 => Some(Self::Velocity),
+            _ => None,
+        }
+    }
+}
+
+/// A motion command for the vehicle (`vehicle/command`).
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/MotionCommand")]
+pub struct MotionCommand {
+    pub header: Header,
+    /// [`CommandKind`] as its discriminant.
+    pub kind: u32,
+    /// Non-zero for commands that must pre-empt everything (panic-stop).
+    pub urgent: u32,
+    pub distance_m: f64,
+    pub angle_rad: f64,
+    pub linear_mps: f64,
+    pub angular_radps: f64,
+    /// Caller-chosen id, echoed in [`EncodersRaw::command_id`] once accepted.
+    pub command_id: u32,
+    pub _pad: u32,
+}
+message!(MotionCommand);
+
+impl MotionCommand {
+    pub fn kind(&self) -> Option<CommandKind> {
+        CommandKind::from_raw(self.kind)
+    }
+}
+
+/// Dead-reckoned odometry with the motion that was commanded (`odometry`).
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/Odometry")]
+pub struct Odometry {
+    pub header: Header,
+    pub world_from_robot: Pose2,
+    /// Distance travelled since the last command was accepted.
+    pub travelled_m: f64,
+    /// Rotation since the last command was accepted.
+    pub turned_rad: f64,
+    pub command: MotionCommand,
+    pub moving: u32,
+    /// 1 once the DRV reported the last command as accepted.
+    pub command_accepted: u32,
+}
+message!(Odometry);
+
+/// An image feature found by a vision worker.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/Feature")]
+pub struct Feature {
+    pub x_px: f32,
+    pub y_px: f32,
+    pub score: f32,
+    pub kind: u32,
+}
+
+/// The answer of a vision worker for one frame (`vision/detections`).
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/Detections")]
+pub struct Detections {
+    pub header: Header,
+    pub frame_seq: u64,
+    pub algorithm: u32,
+    pub count: u32,
+    pub confidence: f32,
+    pub _pad: u32,
+    pub features: [Feature; MAX_FEATURES],
+}
+message!(Detections);
+
+/// The uncertainty map (`ums/map`): a convex polygon around the most likely position and a
+/// heading wedge, in the world frame.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/UncertaintyMap")]
+pub struct UncertaintyMap {
+    pub header: Header,
+    pub centre: Pose2,
+    pub vertex_count: u32,
+    pub _pad: u32,
+    pub vertices_m: [[f64; 2]; MAX_POLYGON_VERTICES],
+    pub heading_cw_rad: f64,
+    pub heading_ccw_rad: f64,
+    pub area_m2: f64,
+}
+message!(UncertaintyMap);
+
+/// Mission states published by the executive.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum MissionState {
+    Running = 0,
+    Succeeded = 1,
+    Failed = 2,
+}
+
+impl MissionState {
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        match raw {
+            0 => Some(Self::Running),
+            1 => Some(Self::Succeeded),
+            2 => Some(Self::Failed),
+            _ => None,
+        }
+    }
+}
+
+/// The executive's progress (`executive/status`).
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/MissionStatus")]
+pub struct MissionStatus {
+    pub header: Header,
+    /// [`MissionState`] as its discriminant.
+    pub state: u32,
+    /// Index of the step under way (== `step_count` when done).
+    pub step: u32,
+    pub step_count: u32,
+    pub _pad: u32,
+    pub estimated: Pose2,
+    pub goal: Pose2,
+    /// Sonar rings, frames' detections and maps seen so far: proof the data flowed.
+    pub sonar_rings_seen: u64,
+    pub detections_seen: u64,
+    pub maps_seen: u64,
+}
+message!(MissionStatus);
+
+impl MissionStatus {
+    pub fn state(&self) -> Option<MissionState> {
+        MissionState::from_raw(self.state)
+    }
+}

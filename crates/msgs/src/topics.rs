@@ -1,0 +1,127 @@
+//! The topic table: every topic's name, payload type and queue sizing, in one place.
+
+use core::marker::PhantomData;
+
+use crate::{
+    Detections, EncodersRaw, MissionStatus, MotionCommand, Odometry, SonarRaw, SonarRing, TruePose,
+    UncertaintyMap,
+};
+
+/// Queue sizing of a topic. Every process opening the topic uses the same numbers, so the
+/// first one to create it fixes them and the others match.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Qos {
+    /// Samples a subscriber may hold queued; the oldest is overwritten when full.
+    pub buffer: usize,
+    /// Samples a subscriber may hold at once while it works on them.
+    pub borrowed: usize,
+    /// Samples a late subscriber receives on connecting.
+    pub history: usize,
+    pub max_publishers: usize,
+    pub max_subscribers: usize,
+}
+
+impl Qos {
+    /// Small fixed-size messages: a few consumers plus the recorder and tools.
+    pub const STATE: Qos = Qos {
+        buffer: 16,
+        borrowed: 2,
+        history: 1,
+        max_publishers: 2,
+        max_subscribers: 8,
+    };
+    /// Camera frames: every slot costs a whole frame of shared memory, so keep them few:
+    /// 3 subscribers x (2 queued + 1 held) + 1 loaned = 10 frames (62 MB at 1080p rgb8,
+    /// 3 MB at 640x480 mono8).
+    pub const FRAMES: Qos = Qos {
+        buffer: 2,
+        borrowed: 1,
+        history: 0,
+        max_publishers: 1,
+        max_subscribers: 3,
+    };
+}
+
+/// A typed topic of fixed-size messages.
+#[derive(Debug)]
+pub struct Topic<T> {
+    pub name: &'static str,
+    pub qos: Qos,
+    _payload: PhantomData<fn() -> T>,
+}
+
+impl<T> Clone for Topic<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Topic<T> {}
+
+impl<T> Topic<T> {
+    pub const fn new(name: &'static str, qos: Qos) -> Self {
+        Self {
+            name,
+            qos,
+            _payload: PhantomData,
+        }
+    }
+}
+
+/// A topic of camera frames: `[u8]` pixels with a [`crate::FrameHeader`].
+#[derive(Debug, Clone, Copy)]
+pub struct FrameTopic {
+    pub name: &'static str,
+    pub qos: Qos,
+}
+
+pub const SIM_TRUTH: Topic<TruePose> = Topic::new("sim/truth", Qos::STATE);
+pub const DRV_SONAR_RAW: Topic<SonarRaw> = Topic::new("drv/sonar_raw", Qos::STATE);
+pub const DRV_ENCODERS_RAW: Topic<EncodersRaw> = Topic::new("drv/encoders_raw", Qos::STATE);
+pub const VEHICLE_COMMAND: Topic<MotionCommand> = Topic::new("vehicle/command", Qos::STATE);
+pub const SONAR_RING: Topic<SonarRing> = Topic::new("sonar/ring", Qos::STATE);
+pub const ODOMETRY: Topic<Odometry> = Topic::new("odometry", Qos::STATE);
+pub const VISION_DETECTIONS: Topic<Detections> = Topic::new("vision/detections", Qos::STATE);
+pub const UMS_MAP: Topic<UncertaintyMap> = Topic::new("ums/map", Qos::STATE);
+pub const EXECUTIVE_STATUS: Topic<MissionStatus> = Topic::new("executive/status", Qos::STATE);
+pub const CAMERA_FRAME: FrameTopic = FrameTopic {
+    name: "camera/frame",
+    qos: Qos::FRAMES,
+};
+
+/// Every topic's name; the recorder must record each of them.
+pub const ALL: &[&str] = &[
+    SIM_TRUTH.name,
+    DRV_SONAR_RAW.name,
+    DRV_ENCODERS_RAW.name,
+    VEHICLE_COMMAND.name,
+    SONAR_RING.name,
+    ODOMETRY.name,
+    VISION_DETECTIONS.name,
+    UMS_MAP.name,
+    EXECUTIVE_STATUS.name,
+    CAMERA_FRAME.name,
+];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn topic_names_are_unique_and_well_formed() {
+        let mut names: Vec<&str> = ALL.to_vec();
+        names.sort_unstable();
+        names.dedup();
+        assert_eq!(names.len(), ALL.len(), "a topic name is listed twice");
+        for name in ALL {
+            assert!(
+                !name.is_empty() && !name.starts_with('/') && !name.ends_with('/'),
+                "{name}"
+            );
+            assert!(
+                name.chars()
+                    .all(|c| c.is_ascii_lowercase() || "_/".contains(c)),
+                "{name}"
+            );
+        }
+    }
+}

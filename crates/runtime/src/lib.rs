@@ -1,0 +1,58 @@
+//! What every Harvey service process shares: logging set-up and the readiness handshake with
+//! the supervisor.
+//!
+//! Readiness: the supervisor passes a pipe's write end in `$HARVEY_READY_FD`; a service calls
+//! [`notify_ready`] once its ports exist, which writes `READY\n` and closes the pipe. A service
+//! started by hand (no variable) skips the handshake.
+
+use std::io::Write;
+use std::os::fd::FromRawFd;
+
+/// Environment variable naming the readiness pipe's file descriptor.
+pub const READY_FD_ENV: &str = "HARVEY_READY_FD";
+/// Environment variable set by the supervisor for its children.
+pub const SUPERVISED_ENV: &str = "HARVEY_SUPERVISED";
+/// The line a ready service writes.
+pub const READY_LINE: &[u8] = b"READY\n";
+
+/// Logs to stderr, filtered by `RUST_LOG` (default `info`). Under the supervisor, which prefixes
+/// and timestamps lines itself, lines are plain.
+pub fn init_logging() {
+    let supervised = std::env::var_os(SUPERVISED_ENV).is_some();
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
+    let builder = tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr);
+    if supervised {
+        builder
+            .without_time()
+            .with_ansi(false)
+            .with_target(false)
+            .init();
+    } else {
+        builder.init();
+    }
+}
+
+/// Tells the supervisor this service is ready. Idempotent: only the first call writes.
+pub fn notify_ready() -> anyhow::Result<()> {
+    let Some(raw) = std::env::var_os(READY_FD_ENV) else {
+        return Ok(());
+    };
+    // Only the first call may use the descriptor; later calls find the variable gone.
+    // SAFETY: single-threaded at this point of start-up in every service.
+    unsafe { std::env::remove_var(READY_FD_ENV) };
+    let fd: i32 = raw
+        .to_str()
+        .and_then(|s| s.parse().ok())
+        .filter(|fd| *fd > 2)
+        .ok_or_else(|| anyhow::anyhow!("${READY_FD_ENV} is not a file descriptor: {raw:?}"))?;
+    // SAFETY: the supervisor opened this descriptor for us alone and nothing else in the
+    // process uses it; the File takes ownership and closes it.
+    let mut pipe = unsafe { std::fs::File::from_raw_fd(fd) };
+    pipe.write_all(READY_LINE)
+        .map_err(|e| anyhow::anyhow!("writing readiness to fd {fd}: {e}"))?;
+    tracing::debug!("ready");
+    Ok(())
+}

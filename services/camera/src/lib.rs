@@ -1,0 +1,1 @@
+//! Camera: renders the simulated world into shared-memory frames.

@@ -1,0 +1,2 @@
+//! harvey-camera: process entry point.
+fn main() {}

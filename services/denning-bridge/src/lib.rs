@@ -1,0 +1,1 @@
+//! Denning bridge: the DRV serial protocol between a serial line and the bus.

@@ -1,0 +1,2 @@
+//! harvey-denning-bridge: process entry point.
+fn main() {}

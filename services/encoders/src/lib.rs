@@ -1,0 +1,1 @@
+//! Encoders: DRV shaft-encoder reports to odometry with the commanded motion.

@@ -1,0 +1,2 @@
+//! harvey-encoders: process entry point.
+fn main() {}

@@ -1,0 +1,1 @@
+//! Executive: runs a mission by commanding motions and monitoring progress.

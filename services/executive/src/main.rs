@@ -1,0 +1,2 @@
+//! harvey-executive: process entry point.
+fn main() {}

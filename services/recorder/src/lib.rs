@@ -1,0 +1,1 @@
+//! Recorder: every topic to an MCAP file with the ROS 2 conventions.

@@ -1,0 +1,2 @@
+//! harvey-recorder: process entry point.
+fn main() {}

@@ -1,0 +1,1 @@
+//! Simulated Denning DRV on a pseudo-terminal.

@@ -1,0 +1,2 @@
+//! harvey-sim-drv: process entry point.
+fn main() {}

@@ -1,0 +1,2 @@
+//! harvey-sonar: process entry point.
+fn main() {}

@@ -1,0 +1,1 @@
+//! UMS: the spatial uncertainty map.

@@ -1,0 +1,2 @@
+//! harvey-ums: process entry point.
+fn main() {}

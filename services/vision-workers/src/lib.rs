@@ -1,0 +1,1 @@
+//! Vision workers: perceptual algorithms on camera frames read in place.

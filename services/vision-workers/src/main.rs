@@ -1,0 +1,2 @@
+//! harvey-vision-workers: process entry point.
+fn main() {}

@@ -1,0 +1,2 @@
+//! harvey CLI
+fn main() {}
