@@ -21,6 +21,6 @@ pub use domain::{
 pub use error::BusError;
 pub use frames::{Frame, FrameLoan, FramePublisher, FrameSubscriber};
 pub use pubsub::{Publisher, Subscriber};
-pub use waiter::{Attachment, Waitable, Waiter, Wake};
+pub use waiter::{Attachment, FdSource, Waitable, Waiter, Wake};
 
 pub type Result<T> = std::result::Result<T, BusError>;

@@ -3,9 +3,13 @@
 
 use core::time::Duration;
 
+use std::os::fd::AsRawFd;
+
 use iceoryx2::port::listener::Listener;
 use iceoryx2::prelude::*;
 use iceoryx2::waitset::{WaitSet, WaitSetGuard, WaitSetRunResult};
+use iceoryx2_bb_posix::file_descriptor::{FileDescriptor, FileDescriptorBased};
+use iceoryx2_bb_posix::file_descriptor_set::SynchronousMultiplexing;
 
 use crate::{BusError, FrameSubscriber, Result, Subscriber};
 
@@ -23,18 +27,51 @@ pub enum Wake {
 /// Something a [`Waiter`] can sleep on.
 pub trait Waitable {
     #[doc(hidden)]
-    fn listener(&self) -> &Listener<ipc::Service>;
+    fn multiplexed(&self) -> &dyn Multiplexed;
 }
 
+#[doc(hidden)]
+pub trait Multiplexed: SynchronousMultiplexing + core::fmt::Debug {}
+impl<T: SynchronousMultiplexing + core::fmt::Debug> Multiplexed for T {}
+
 impl<T: harvey_msgs::Message> Waitable for Subscriber<T> {
-    fn listener(&self) -> &Listener<ipc::Service> {
+    fn multiplexed(&self) -> &dyn Multiplexed {
         &self.listener
     }
 }
 
 impl Waitable for FrameSubscriber {
-    fn listener(&self) -> &Listener<ipc::Service> {
+    fn multiplexed(&self) -> &dyn Multiplexed {
         &self.listener
+    }
+}
+
+/// A file descriptor (a serial line, a pipe) a [`Waiter`] can sleep on beside the bus. It does
+/// not own the descriptor: keep the file open while this exists.
+#[derive(Debug)]
+pub struct FdSource {
+    fd: FileDescriptor,
+}
+
+impl FdSource {
+    pub fn new(fd: &impl AsRawFd) -> Result<Self> {
+        let raw = fd.as_raw_fd();
+        FileDescriptor::non_owning_new(raw)
+            .map(|fd| Self { fd })
+            .ok_or_else(|| BusError::Wait(format!("file descriptor {raw} is not open")))
+    }
+}
+
+impl FileDescriptorBased for FdSource {
+    fn file_descriptor(&self) -> &FileDescriptor {
+        &self.fd
+    }
+}
+impl SynchronousMultiplexing for FdSource {}
+
+impl Waitable for FdSource {
+    fn multiplexed(&self) -> &dyn Multiplexed {
+        self
     }
 }
 
@@ -67,7 +104,7 @@ impl Waiter {
     pub fn attach<'w, 'a>(&'w self, source: &'a impl Waitable) -> Result<Attachment<'w, 'a>> {
         let guard = self
             .waitset
-            .attach_notification(source.listener())
+            .attach_notification(source.multiplexed())
             .map_err(|e| BusError::Wait(format!("cannot attach: {e:?}")))?;
         Ok(Attachment { _guard: guard })
     }

@@ -105,7 +105,7 @@ mod tests {
         vec![
             Line::Command(Command::Move {
                 id: 7,
-                tenths_ft: -123,
+                hundredths_ft: -123,
             }),
             Line::Command(Command::Turn {
                 id: 8,
@@ -114,13 +114,13 @@ mod tests {
             Line::Command(Command::Stop { id: 9 }),
             Line::Command(Command::Velocity {
                 id: 10,
-                tenths_ft_per_s: 5,
+                hundredths_ft_per_s: 5,
                 tenths_deg_per_s: -30,
             }),
             Line::Report(Report::Encoders {
                 time_ms: 123_456,
-                x_tenths_ft: 10,
-                y_tenths_ft: -4,
+                x_hundredths_ft: 10,
+                y_hundredths_ft: -4,
                 heading_tenths_deg: 3599,
                 moving: true,
                 command_id: 8,

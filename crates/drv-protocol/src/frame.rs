@@ -9,8 +9,8 @@ pub const SONAR_NO_ECHO: u16 = 255;
 /// Host → DRV.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Command {
-    /// Translate along the current heading by `tenths_ft` (negative: backwards).
-    Move { id: u32, tenths_ft: i32 },
+    /// Translate along the current heading by `hundredths_ft` (negative: backwards).
+    Move { id: u32, hundredths_ft: i32 },
     /// Rotate in place by `tenths_deg`, counter-clockwise positive.
     Turn { id: u32, tenths_deg: i32 },
     /// Stop at once, abandoning any motion.
@@ -18,7 +18,7 @@ pub enum Command {
     /// Drive at a steady speed until the next command.
     Velocity {
         id: u32,
-        tenths_ft_per_s: i32,
+        hundredths_ft_per_s: i32,
         tenths_deg_per_s: i32,
     },
 }
@@ -29,8 +29,8 @@ pub enum Report {
     /// Shaft-encoder dead reckoning: position and heading since power-up.
     Encoders {
         time_ms: u64,
-        x_tenths_ft: i32,
-        y_tenths_ft: i32,
+        x_hundredths_ft: i32,
+        y_hundredths_ft: i32,
         heading_tenths_deg: i32,
         moving: bool,
         command_id: u32,
@@ -79,27 +79,29 @@ pub fn encode(line: &Line) -> String {
     let mut body = String::with_capacity(64);
     // Writing into a String cannot fail.
     let _ = match line {
-        Line::Command(Command::Move { id, tenths_ft }) => write!(body, "MV {id} {tenths_ft}"),
+        Line::Command(Command::Move { id, hundredths_ft }) => {
+            write!(body, "MV {id} {hundredths_ft}")
+        }
         Line::Command(Command::Turn { id, tenths_deg }) => write!(body, "TN {id} {tenths_deg}"),
         Line::Command(Command::Stop { id }) => write!(body, "ST {id}"),
         Line::Command(Command::Velocity {
             id,
-            tenths_ft_per_s,
+            hundredths_ft_per_s,
             tenths_deg_per_s,
         }) => {
-            write!(body, "VL {id} {tenths_ft_per_s} {tenths_deg_per_s}")
+            write!(body, "VL {id} {hundredths_ft_per_s} {tenths_deg_per_s}")
         }
         Line::Report(Report::Encoders {
             time_ms,
-            x_tenths_ft,
-            y_tenths_ft,
+            x_hundredths_ft,
+            y_hundredths_ft,
             heading_tenths_deg,
             moving,
             command_id,
         }) => {
             write!(
                 body,
-                "EN {time_ms} {x_tenths_ft} {y_tenths_ft} {heading_tenths_deg} {} {command_id}",
+                "EN {time_ms} {x_hundredths_ft} {y_hundredths_ft} {heading_tenths_deg} {} {command_id}",
                 u8::from(*moving)
             )
         }
@@ -175,7 +177,7 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
             arity(2)?;
             Line::Command(Command::Move {
                 id: id(0)?,
-                tenths_ft: fit(num(1)?, "distance")?,
+                hundredths_ft: fit(num(1)?, "distance")?,
             })
         }
         "TN" => {
@@ -193,7 +195,7 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
             arity(3)?;
             Line::Command(Command::Velocity {
                 id: id(0)?,
-                tenths_ft_per_s: fit(num(1)?, "speed")?,
+                hundredths_ft_per_s: fit(num(1)?, "speed")?,
                 tenths_deg_per_s: fit(num(2)?, "rate")?,
             })
         }
@@ -206,8 +208,8 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
             };
             Line::Report(Report::Encoders {
                 time_ms: time(0)?,
-                x_tenths_ft: fit(num(1)?, "x")?,
-                y_tenths_ft: fit(num(2)?, "y")?,
+                x_hundredths_ft: fit(num(1)?, "x")?,
+                y_hundredths_ft: fit(num(2)?, "y")?,
                 heading_tenths_deg: fit(num(3)?, "heading")?,
                 moving,
                 command_id: id(5)?,

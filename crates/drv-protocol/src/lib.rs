@@ -4,6 +4,7 @@
 
 mod decoder;
 mod frame;
+pub mod serial;
 
 pub use decoder::{Decoder, DecoderStats};
 pub use frame::{Command, FrameError, Line, NakReason, Report, SONAR_NO_ECHO, encode};

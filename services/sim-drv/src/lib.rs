@@ -1,1 +1,309 @@
-//! Simulated Denning DRV on a pseudo-terminal.
+//! The simulated Denning DRV: a pure state machine that accepts DRV commands, moves through the
+//! world with the terrain error model, and produces what a DRV reports (shaft encoders and sonar
+//! banks, in the DRV's units), plus the true pose for the simulator's own topic.
+//!
+//! `main.rs` puts it on a pseudo-terminal and paces it; nothing here reads a clock.
+
+pub mod motion;
+pub mod rng;
+pub mod sonar;
+
+use harvey_drv_protocol::{Command, NakReason, Report};
+use harvey_world::World;
+
+use motion::{FT, Motion, Pose};
+use rng::Rng;
+
+/// Longest MOVE the DRV accepts, in feet.
+pub const MAX_MOVE_FT: f64 = 100.0;
+/// Largest TURN the DRV accepts, in degrees.
+pub const MAX_TURN_DEG: f64 = 360.0;
+
+/// What one tick produces.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TickOutput {
+    pub time_ms: u64,
+    pub truth: Pose,
+    pub reports: Vec<Report>,
+}
+
+/// The simulated vehicle.
+pub struct SimDrv {
+    world: World,
+    tick_ms: u64,
+    rng: Rng,
+    time_ms: u64,
+    truth: Pose,
+    encoders: Pose,
+    motion: Option<Motion>,
+    last_command: u32,
+    next_bank: u8,
+    /// Which way this vehicle's drive train pulls (002 §3.2: drift): fixed per seed.
+    drift_sign: f64,
+}
+
+impl SimDrv {
+    pub fn new(world: World, tick_ms: u64, seed: u64) -> Self {
+        let mut rng = Rng::new(seed);
+        let drift_sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
+        let s = world.start;
+        let truth = Pose {
+            x: s.x_m,
+            y: s.y_m,
+            th: s.heading_deg.to_radians(),
+        };
+        Self {
+            world,
+            tick_ms,
+            rng,
+            time_ms: 0,
+            truth,
+            encoders: truth,
+            motion: None,
+            last_command: 0,
+            next_bank: 0,
+            drift_sign,
+        }
+    }
+
+    pub fn truth(&self) -> Pose {
+        self.truth
+    }
+
+    pub fn time_ms(&self) -> u64 {
+        self.time_ms
+    }
+
+    pub fn is_moving(&self) -> bool {
+        self.motion.is_some()
+    }
+
+    /// Accepts or refuses a command; the answer goes back on the line at once.
+    pub fn handle(&mut self, cmd: Command) -> Report {
+        let t = self.world.ground_terrain().clone();
+        let r = self.world.robot.clone();
+        let (id, motion) = match cmd {
+            Command::Stop { id } => {
+                self.motion = None;
+                (id, None)
+            }
+            Command::Move { id, hundredths_ft } => {
+                let ft = f64::from(hundredths_ft) / 100.0;
+                if ft.abs() > MAX_MOVE_FT {
+                    return Report::Nak {
+                        id,
+                        reason: NakReason::OutOfRange,
+                    };
+                }
+                if self.motion.is_some() {
+                    return Report::Nak {
+                        id,
+                        reason: NakReason::Busy,
+                    };
+                }
+                let m = motion::plan_move(
+                    &t,
+                    &mut self.rng,
+                    self.drift_sign,
+                    self.truth,
+                    self.encoders,
+                    ft * FT,
+                    r.speed_mps,
+                );
+                (id, Some(m))
+            }
+            Command::Turn { id, tenths_deg } => {
+                let deg = f64::from(tenths_deg) / 10.0;
+                if deg.abs() > MAX_TURN_DEG {
+                    return Report::Nak {
+                        id,
+                        reason: NakReason::OutOfRange,
+                    };
+                }
+                if self.motion.is_some() {
+                    return Report::Nak {
+                        id,
+                        reason: NakReason::Busy,
+                    };
+                }
+                let rate = r.turn_rate_degps.to_radians();
+                (
+                    id,
+                    Some(motion::plan_turn(
+                        &t,
+                        &mut self.rng,
+                        self.truth,
+                        self.encoders,
+                        deg.to_radians(),
+                        rate,
+                    )),
+                )
+            }
+            Command::Velocity {
+                id,
+                hundredths_ft_per_s,
+                tenths_deg_per_s,
+            } => {
+                let v = f64::from(hundredths_ft_per_s) / 100.0 * FT;
+                let w = (f64::from(tenths_deg_per_s) / 10.0).to_radians();
+                if v.abs() > r.speed_mps * 1.5 || w.abs() > r.turn_rate_degps.to_radians() * 1.5 {
+                    return Report::Nak {
+                        id,
+                        reason: NakReason::OutOfRange,
+                    };
+                }
+                let drift = self.drift_sign
+                    * self
+                        .rng
+                        .normal(t.drift_deg_per_ft, t.drift_sd_deg_per_ft)
+                        .to_radians()
+                    / FT;
+                let idle = v == 0.0 && w == 0.0;
+                (
+                    id,
+                    (!idle).then_some(Motion::Velocity {
+                        v_mps: v,
+                        w_radps: w,
+                        drift_rad_per_m: drift,
+                    }),
+                )
+            }
+        };
+        self.motion = motion;
+        self.last_command = id;
+        Report::Ack { id }
+    }
+
+    /// Advances time by one tick: moves, fires the next sonar bank, reports encoders.
+    pub fn tick(&mut self) -> TickOutput {
+        self.time_ms += self.tick_ms;
+        let dt_s = self.tick_ms as f64 / 1000.0;
+        if let Some(m) = &mut self.motion {
+            let t = self.world.ground_terrain();
+            let (truth, enc, finished) = motion::advance(m, t, self.truth, self.encoders, dt_s);
+            self.truth = truth;
+            self.encoders = enc;
+            if finished {
+                self.motion = None;
+            }
+        }
+        let bank = self.next_bank;
+        self.next_bank = (bank + 1) % 3;
+        let ranges_tenths_ft = sonar::fire_bank(&self.world, self.truth, bank);
+        let heading_deg = self.encoders.th.to_degrees().rem_euclid(360.0);
+        let reports = vec![
+            Report::Encoders {
+                time_ms: self.time_ms,
+                x_hundredths_ft: (self.encoders.x / FT * 100.0).round() as i32,
+                y_hundredths_ft: (self.encoders.y / FT * 100.0).round() as i32,
+                heading_tenths_deg: ((heading_deg * 10.0).round() as i32) % 3600,
+                moving: self.motion.is_some(),
+                command_id: self.last_command,
+            },
+            Report::Sonar {
+                time_ms: self.time_ms,
+                bank,
+                ranges_tenths_ft,
+            },
+        ];
+        TickOutput {
+            time_ms: self.time_ms,
+            truth: self.truth,
+            reports,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sim(seed: u64) -> SimDrv {
+        let w = harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway")
+            .expect("loads");
+        SimDrv::new(w, 50, seed)
+    }
+
+    #[test]
+    fn a_move_runs_to_completion_and_reports_it() {
+        let mut s = sim(3);
+        assert_eq!(
+            s.handle(Command::Move {
+                id: 1,
+                hundredths_ft: 1000
+            }),
+            Report::Ack { id: 1 }
+        );
+        assert_eq!(
+            s.handle(Command::Move {
+                id: 2,
+                hundredths_ft: 1000
+            }),
+            Report::Nak {
+                id: 2,
+                reason: NakReason::Busy
+            }
+        );
+        let mut last = None;
+        for _ in 0..400 {
+            last = Some(s.tick());
+            if !s.is_moving() {
+                break;
+            }
+        }
+        let out = last.expect("ticked");
+        assert!(!s.is_moving());
+        let Report::Encoders {
+            x_hundredths_ft,
+            moving,
+            command_id,
+            ..
+        } = out.reports[0]
+        else {
+            panic!("{out:?}")
+        };
+        assert_eq!((x_hundredths_ft, moving, command_id), (1000, false, 1));
+        let true_ft = out.truth.x / FT;
+        assert!(true_ft < 10.0 && true_ft > 9.4, "{true_ft}");
+    }
+
+    #[test]
+    fn impossible_commands_are_refused() {
+        let mut s = sim(3);
+        assert_eq!(
+            s.handle(Command::Move {
+                id: 5,
+                hundredths_ft: 528_000
+            }),
+            Report::Nak {
+                id: 5,
+                reason: NakReason::OutOfRange
+            }
+        );
+        assert_eq!(
+            s.handle(Command::Turn {
+                id: 6,
+                tenths_deg: 7200
+            }),
+            Report::Nak {
+                id: 6,
+                reason: NakReason::OutOfRange
+            }
+        );
+        assert!(!s.is_moving());
+    }
+
+    #[test]
+    fn same_seed_same_run() {
+        let run = |seed| {
+            let mut s = sim(seed);
+            s.handle(Command::Turn {
+                id: 1,
+                tenths_deg: 450,
+            });
+            (0..100).map(|_| s.tick()).collect::<Vec<_>>()
+        };
+        assert_eq!(run(9), run(9));
+        assert_ne!(run(9), run(10));
+    }
+}

@@ -1,2 +1,113 @@
-//! harvey-sim-drv: process entry point.
-fn main() {}
+//! harvey-sim-drv: the simulated Denning DRV on a pseudo-terminal. The bridge opens the
+//! terminal's slave end (a symlink at `--pty`) as if it were the DRV's serial port.
+
+use std::fs::File;
+use std::path::PathBuf;
+use std::time::{Duration, Instant};
+
+use anyhow::Context;
+use clap::Parser;
+use harvey_bus::{Bus, FdSource, Waiter, Wake};
+use harvey_drv_protocol::serial::{make_raw, read_available, set_nonblocking, write_frame};
+use harvey_drv_protocol::{Decoder, Line, encode};
+use harvey_msgs::{Header, Pose2, TruePose, topics};
+use harvey_sim_drv::SimDrv;
+
+#[derive(Parser)]
+#[command(about = "Simulated Denning DRV speaking the DRV protocol on a pseudo-terminal")]
+struct Args {
+    /// World file to drive in.
+    #[arg(long)]
+    world: PathBuf,
+    /// Where to put the symlink to the terminal the bridge opens.
+    #[arg(long)]
+    pty: PathBuf,
+    /// Simulated time per tick.
+    #[arg(long, default_value_t = 50)]
+    tick_ms: u64,
+    /// Simulated seconds per wall-clock second.
+    #[arg(long, default_value_t = 1.0)]
+    speedup: f64,
+    /// Seed of the error model.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+}
+
+fn main() -> anyhow::Result<()> {
+    harvey_runtime::init_logging();
+    let args = Args::parse();
+    anyhow::ensure!(
+        args.tick_ms > 0 && args.speedup > 0.0,
+        "--tick-ms and --speedup must be positive"
+    );
+    let world = harvey_world::World::load(&args.world)?;
+    let mut sim = SimDrv::new(world, args.tick_ms, args.seed);
+
+    let bus = Bus::join("sim-drv")?;
+    let truth_pub = bus.publisher(topics::SIM_TRUTH)?;
+
+    let pty = nix::pty::openpty(None, None).context("opening a pseudo-terminal")?;
+    make_raw(&pty.slave).context("setting the pseudo-terminal to raw mode")?;
+    set_nonblocking(&pty.master).context("making the pseudo-terminal non-blocking")?;
+    let slave_path = nix::unistd::ttyname(&pty.slave).context("naming the pseudo-terminal")?;
+    let _ = std::fs::remove_file(&args.pty);
+    std::os::unix::fs::symlink(&slave_path, &args.pty)
+        .with_context(|| format!("linking {} -> {}", args.pty.display(), slave_path.display()))?;
+    // Keep the slave open ourselves so the line stays up while the bridge restarts.
+    let _slave = pty.slave;
+    let mut line = File::from(pty.master);
+
+    let waiter = Waiter::new()?;
+    let line_source = FdSource::new(&line)?;
+    let _line_attached = waiter.attach(&line_source)?;
+    harvey_runtime::notify_ready()?;
+    tracing::info!(pty = %args.pty.display(), tty = %slave_path.display(), seed = args.seed, "simulated DRV up");
+
+    let period = Duration::from_secs_f64(args.tick_ms as f64 / 1000.0 / args.speedup);
+    let mut next_tick = Instant::now() + period;
+    let mut decoder = Decoder::new();
+    let mut buf = Vec::new();
+    let mut dropped_frames = 0u64;
+    loop {
+        let now = Instant::now();
+        if now < next_tick && waiter.wait(Some(next_tick - now))? == Wake::Shutdown {
+            break;
+        }
+        read_available(&mut line, &mut buf).context("reading the pseudo-terminal")?;
+        let mut replies = Vec::new();
+        decoder.push(&buf, |frame| match frame {
+            Ok(Line::Command(cmd)) => replies.push(sim.handle(cmd)),
+            Ok(Line::Report(r)) => tracing::warn!(?r, "ignoring a report sent to the DRV"),
+            Err(e) => tracing::warn!("bad frame from the host: {e}"),
+        });
+        for r in replies {
+            dropped_frames += u64::from(!write_frame(
+                &mut line,
+                encode(&Line::Report(r)).as_bytes(),
+            )?);
+        }
+        if Instant::now() >= next_tick {
+            next_tick += period;
+            let out = sim.tick();
+            for r in &out.reports {
+                dropped_frames += u64::from(!write_frame(
+                    &mut line,
+                    encode(&Line::Report(*r)).as_bytes(),
+                )?);
+            }
+            let stamp_ns = out.time_ms * 1_000_000;
+            let pose = Pose2 {
+                x_m: out.truth.x,
+                y_m: out.truth.y,
+                heading_rad: out.truth.th,
+            };
+            truth_pub.send(&TruePose {
+                header: Header::new(stamp_ns / (args.tick_ms * 1_000_000), stamp_ns),
+                world_from_robot: pose,
+            })?;
+        }
+    }
+    let _ = std::fs::remove_file(&args.pty);
+    tracing::info!(time_ms = sim.time_ms(), dropped_frames, stats = ?decoder.stats(), "simulated DRV stopped");
+    Ok(())
+}

@@ -1,0 +1,73 @@
+//! Ray casting against the walls, for the sonar model and the camera renderer.
+
+use crate::World;
+
+/// Where a ray meets a wall.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    pub distance_m: f64,
+    pub wall: usize,
+    /// Distance along the wall from its `from` end.
+    pub along_m: f64,
+    /// Angle between the ray and the wall's normal, 0 = head-on, π/2 = grazing.
+    pub incidence_rad: f64,
+}
+
+impl World {
+    /// The nearest wall hit by the ray from `origin` along unit direction `dir`, within `max_m`.
+    pub fn cast_ray(&self, origin: [f64; 2], dir: [f64; 2], max_m: f64) -> Option<Hit> {
+        let mut best: Option<Hit> = None;
+        for (i, w) in self.walls.iter().enumerate() {
+            let e = [w.to[0] - w.from[0], w.to[1] - w.from[1]];
+            let denom = dir[0] * e[1] - dir[1] * e[0];
+            if denom.abs() < 1e-12 {
+                continue; // parallel
+            }
+            let d = [w.from[0] - origin[0], w.from[1] - origin[1]];
+            let t = (d[0] * e[1] - d[1] * e[0]) / denom; // along the ray
+            let s = (d[0] * dir[1] - d[1] * dir[0]) / denom; // along the wall, 0..1
+            if t <= 1e-9 || !(0.0..=1.0).contains(&s) || t > max_m {
+                continue;
+            }
+            if best.is_some_and(|b| b.distance_m <= t) {
+                continue;
+            }
+            let len = e[0].hypot(e[1]);
+            let cos_inc = (denom / len).abs(); // |dir x e| / |e| = |cos| of angle to normal
+            best = Some(Hit {
+                distance_m: t,
+                wall: i,
+                along_m: s * len,
+                incidence_rad: cos_inc.clamp(0.0, 1.0).acos(),
+            });
+        }
+        best
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::load_str;
+
+    #[test]
+    fn rays_hit_the_nearest_wall_with_the_right_incidence() {
+        let w = load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads");
+        // Straight across the corridor from its centre line: head-on.
+        let hit = w
+            .cast_ray([2.0, 0.0], [0.0, 1.0], 100.0)
+            .expect("hits the left wall");
+        assert!((hit.distance_m - 1.0).abs() < 1e-9, "{hit:?}");
+        assert!(hit.incidence_rad.abs() < 1e-9);
+        // At 60 degrees off the normal the distance is 1 / cos 60 = 2.
+        let a = 30f64.to_radians();
+        let hit = w
+            .cast_ray([2.0, 0.0], [a.cos(), a.sin()], 100.0)
+            .expect("hits");
+        assert!((hit.distance_m - 2.0).abs() < 1e-9, "{hit:?}");
+        assert!((hit.incidence_rad - 60f64.to_radians()).abs() < 1e-9);
+        assert!(
+            w.cast_ray([2.0, 0.0], [0.0, 1.0], 0.5).is_none(),
+            "beyond max range"
+        );
+    }
+}

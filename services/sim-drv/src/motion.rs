@@ -1,0 +1,273 @@
+//! Executing TURN, MOVE and velocity commands with the terrain error model of 002 §3.2
+//! (Table 3): the true path loses distance, drifts and skitters; the encoders report the
+//! commanded path.
+
+use harvey_world::Terrain;
+
+use crate::rng::Rng;
+
+pub const FT: f64 = 0.3048;
+
+/// A planar pose, SI.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Pose {
+    pub x: f64,
+    pub y: f64,
+    pub th: f64,
+}
+
+impl Pose {
+    /// The pose reached by driving `s` metres from here while the heading changes linearly by
+    /// `dth` over the way (an arc; a straight line when `dth` is 0).
+    pub fn arc(&self, s: f64, dth: f64) -> Pose {
+        if dth.abs() < 1e-9 {
+            return Pose {
+                x: self.x + s * self.th.cos(),
+                y: self.y + s * self.th.sin(),
+                th: self.th,
+            };
+        }
+        let r = s / dth;
+        Pose {
+            x: self.x + r * ((self.th + dth).sin() - self.th.sin()),
+            y: self.y - r * ((self.th + dth).cos() - self.th.cos()),
+            th: self.th + dth,
+        }
+    }
+
+    /// Shifted sideways by `d` metres (positive: to the left of the heading).
+    pub fn sideways(&self, d: f64) -> Pose {
+        Pose {
+            x: self.x - d * self.th.sin(),
+            y: self.y + d * self.th.cos(),
+            th: self.th,
+        }
+    }
+}
+
+/// A motion under way: where it started, where it will end (true and encoder), how far along.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Motion {
+    Move {
+        truth0: Pose,
+        enc0: Pose,
+        true_m: f64,
+        true_dth: f64,
+        commanded_m: f64,
+        done: f64,
+        duration_s: f64,
+    },
+    Turn {
+        truth0: Pose,
+        enc0: Pose,
+        true_rad: f64,
+        skitter_m: f64,
+        commanded_rad: f64,
+        done: f64,
+        duration_s: f64,
+    },
+    Velocity {
+        v_mps: f64,
+        w_radps: f64,
+        drift_rad_per_m: f64,
+    },
+}
+
+/// Draws the true outcome of a MOVE of `commanded_m`. The robot never goes further than
+/// commanded (002 §3.2).
+pub fn plan_move(
+    t: &Terrain,
+    rng: &mut Rng,
+    drift_sign: f64,
+    truth0: Pose,
+    enc0: Pose,
+    commanded_m: f64,
+    speed_mps: f64,
+) -> Motion {
+    let ft = commanded_m.abs() / FT;
+    let loss_ft = t.translational_loss_ft_per_ft * ft
+        + t.inertial_loss_ft
+        + rng.normal(0.0, t.translational_sd_ft_per_ft * ft);
+    let true_ft = (ft - loss_ft).clamp(0.0, ft);
+    let drift_deg = drift_sign * rng.normal(t.drift_deg_per_ft, t.drift_sd_deg_per_ft) * true_ft;
+    Motion::Move {
+        truth0,
+        enc0,
+        true_m: true_ft * FT * commanded_m.signum(),
+        true_dth: drift_deg.to_radians(),
+        commanded_m,
+        done: 0.0,
+        duration_s: commanded_m.abs() / speed_mps,
+    }
+}
+
+/// Draws the true outcome of a TURN of `commanded_rad` (counter-clockwise positive).
+pub fn plan_turn(
+    t: &Terrain,
+    rng: &mut Rng,
+    truth0: Pose,
+    enc0: Pose,
+    commanded_rad: f64,
+    rate_radps: f64,
+) -> Motion {
+    let deg = commanded_rad.abs().to_degrees();
+    let loss = (t.rotational_loss_deg_per_deg + rng.normal(0.0, t.rotational_sd_deg_per_deg)) * deg;
+    let true_deg = (deg - loss).clamp(0.0, deg);
+    let skitter_ft = rng
+        .normal(t.skitter_ft_per_deg, t.skitter_sd_ft_per_deg)
+        .max(0.0)
+        * deg;
+    Motion::Turn {
+        truth0,
+        enc0,
+        true_rad: true_deg.to_radians() * commanded_rad.signum(),
+        // To the left while turning counter-clockwise, to the right while turning clockwise.
+        skitter_m: skitter_ft * FT * commanded_rad.signum(),
+        commanded_rad,
+        done: 0.0,
+        duration_s: commanded_rad.abs() / rate_radps,
+    }
+}
+
+/// Advances a motion by `dt_s`; returns the new (truth, encoder) poses and whether it finished.
+pub fn advance(
+    m: &mut Motion,
+    t: &Terrain,
+    truth: Pose,
+    enc: Pose,
+    dt_s: f64,
+) -> (Pose, Pose, bool) {
+    match m {
+        Motion::Move {
+            truth0,
+            enc0,
+            true_m,
+            true_dth,
+            commanded_m,
+            done,
+            duration_s,
+        } => {
+            *done = if *duration_s > 0.0 {
+                (*done + dt_s / *duration_s).min(1.0)
+            } else {
+                1.0
+            };
+            let f = *done;
+            (
+                truth0.arc(f * *true_m, f * *true_dth),
+                enc0.arc(f * *commanded_m, 0.0),
+                f >= 1.0,
+            )
+        }
+        Motion::Turn {
+            truth0,
+            enc0,
+            true_rad,
+            skitter_m,
+            commanded_rad,
+            done,
+            duration_s,
+        } => {
+            *done = if *duration_s > 0.0 {
+                (*done + dt_s / *duration_s).min(1.0)
+            } else {
+                1.0
+            };
+            let f = *done;
+            let shifted = truth0.sideways(f * *skitter_m);
+            let truth = Pose {
+                th: truth0.th + f * *true_rad,
+                ..shifted
+            };
+            (
+                truth,
+                Pose {
+                    th: enc0.th + f * *commanded_rad,
+                    ..*enc0
+                },
+                f >= 1.0,
+            )
+        }
+        Motion::Velocity {
+            v_mps,
+            w_radps,
+            drift_rad_per_m,
+        } => {
+            let s_true = *v_mps * (1.0 - t.translational_loss_ft_per_ft) * dt_s;
+            let dth_true = *w_radps * (1.0 - t.rotational_loss_deg_per_deg) * dt_s
+                + *drift_rad_per_m * s_true.abs();
+            let idle = *v_mps == 0.0 && *w_radps == 0.0;
+            (
+                truth.arc(s_true, dth_true),
+                enc.arc(*v_mps * dt_s, *w_radps * dt_s),
+                idle,
+            )
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tile() -> Terrain {
+        Terrain {
+            translational_loss_ft_per_ft: 0.042,
+            inertial_loss_ft: 0.0084,
+            translational_sd_ft_per_ft: 0.0028,
+            drift_deg_per_ft: 0.27,
+            drift_sd_deg_per_ft: 0.12,
+            rotational_loss_deg_per_deg: 0.018,
+            rotational_sd_deg_per_deg: 0.006,
+            skitter_ft_per_deg: 0.0013,
+            skitter_sd_ft_per_deg: 0.00013,
+        }
+    }
+
+    #[test]
+    fn a_move_loses_distance_as_table_3_says_and_never_overshoots() {
+        let mut rng = Rng::new(11);
+        let n = 2000;
+        let mut travelled_ft = Vec::new();
+        for _ in 0..n {
+            let mut m = plan_move(
+                &tile(),
+                &mut rng,
+                1.0,
+                Pose::default(),
+                Pose::default(),
+                20.0 * FT,
+                0.3,
+            );
+            let (truth, enc, finished) =
+                advance(&mut m, &tile(), Pose::default(), Pose::default(), 1e6);
+            assert!(finished);
+            assert!(
+                (enc.x - 20.0 * FT).abs() < 1e-9,
+                "encoders report the commanded move"
+            );
+            let d = truth.x.hypot(truth.y) / FT;
+            assert!(d <= 20.0 + 1e-9, "never further than commanded: {d}");
+            travelled_ft.push(d);
+        }
+        let mean = travelled_ft.iter().sum::<f64>() / n as f64;
+        // 20 ft at 4.2 % loss plus 0.0084 ft inertial loss; the arc's chord is a hair shorter.
+        let expected = 20.0 - 20.0 * 0.042 - 0.0084;
+        assert!((mean - expected).abs() < 0.01, "mean {mean} vs {expected}");
+    }
+
+    #[test]
+    fn arcs_and_turns_compose() {
+        let p = Pose {
+            x: 1.0,
+            y: 2.0,
+            th: 0.5,
+        };
+        let q = p.arc(3.0, 0.0);
+        assert!((q.x - (1.0 + 3.0 * 0.5f64.cos())).abs() < 1e-12);
+        let r = p.arc(1e-3, 1e-12);
+        assert!((r.x - p.arc(1e-3, 0.0).x).abs() < 1e-9);
+        let s = Pose::default().sideways(1.0);
+        assert!((s.y - 1.0).abs() < 1e-12 && s.x.abs() < 1e-12);
+    }
+}
