@@ -15,19 +15,11 @@ pub const DEFAULT_PREFIX: &str = "harvey_";
 /// Checks that a prefix can name shared-memory objects and files: 1–40 ASCII letters, digits,
 /// `_` or `-`.
 pub fn validate_prefix(prefix: &str) -> Result<()> {
-    let bad = |reason| {
-        Err(BusError::BadPrefix {
-            prefix: prefix.to_owned(),
-            reason,
-        })
-    };
+    let bad = |reason| Err(BusError::BadPrefix { prefix: prefix.to_owned(), reason });
     if prefix.is_empty() || prefix.len() > 40 {
         return bad("must be 1 to 40 characters long");
     }
-    if !prefix
-        .bytes()
-        .all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
-    {
+    if !prefix.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-') {
         return bad("only ASCII letters, digits, `_` and `-` are allowed");
     }
     Ok(())
@@ -61,20 +53,14 @@ impl Bus {
     pub fn join_with_prefix(name: &str, prefix: &str) -> Result<Self> {
         iceoryx2::prelude::set_log_level(LogLevel::Error);
         let config = domain_config(prefix)?;
-        let fail = |detail: String| BusError::Node {
-            node: name.to_owned(),
-            detail,
-        };
+        let fail = |detail: String| BusError::Node { node: name.to_owned(), detail };
         let node_name = NodeName::new(name).map_err(|e| fail(format!("{e:?}")))?;
         let node = NodeBuilder::new()
             .name(&node_name)
             .config(&config)
             .create::<ipc::Service>()
             .map_err(|e| fail(format!("{e:?}")))?;
-        Ok(Self {
-            node,
-            prefix: prefix.to_owned(),
-        })
+        Ok(Self { node, prefix: prefix.to_owned() })
     }
 
     pub fn prefix(&self) -> &str {
@@ -117,10 +103,7 @@ pub fn live_nodes(prefix: &str) -> Result<Vec<NodeInfo>> {
         }
         CallbackProgression::Continue
     })
-    .map_err(|e| BusError::Node {
-        node: "*".into(),
-        detail: format!("listing nodes: {e:?}"),
-    })?;
+    .map_err(|e| BusError::Node { node: "*".into(), detail: format!("listing nodes: {e:?}") })?;
     Ok(nodes)
 }
 
@@ -139,10 +122,7 @@ pub fn cleanup_dead_nodes(prefix: &str) -> Result<usize> {
         }
         CallbackProgression::Continue
     })
-    .map_err(|e| BusError::Node {
-        node: "*".into(),
-        detail: format!("listing nodes: {e:?}"),
-    })?;
+    .map_err(|e| BusError::Node { node: "*".into(), detail: format!("listing nodes: {e:?}") })?;
     if !failures.is_empty() {
         tracing::warn!(prefix, ?failures, "some dead nodes could not be cleaned");
     }

@@ -17,13 +17,8 @@ use crate::{Bus, BusError, Result};
 fn open_frame_service(
     bus: &Bus,
     topic: FrameTopic,
-) -> Result<
-    iceoryx2::service::port_factory::publish_subscribe::PortFactory<
-        ipc::Service,
-        [u8],
-        FrameHeader,
-    >,
-> {
+) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, [u8], FrameHeader>>
+{
     let qos = topic.qos;
     bus.node
         .service_builder(&Bus::service_name(topic.name)?)
@@ -71,10 +66,7 @@ impl FramePublisher {
             return Err(BusError::Topic {
                 topic: self.topic.to_owned(),
                 what: "frame size out of range",
-                detail: format!(
-                    "{len} bytes, publisher sized for 1..={}",
-                    self.max_frame_bytes
-                ),
+                detail: format!("{len} bytes, publisher sized for 1..={}", self.max_frame_bytes),
             });
         }
         let mut uninit = self
@@ -87,10 +79,7 @@ impl FramePublisher {
         // earlier frames. Every byte is therefore an initialised `u8`; `MaybeUninit` is
         // iceoryx2's conservative typing, not a statement about this memory.
         let sample = unsafe { uninit.assume_init() };
-        Ok(FrameLoan {
-            publisher: self,
-            sample,
-        })
+        Ok(FrameLoan { publisher: self, sample })
     }
 }
 
@@ -107,14 +96,8 @@ impl FrameLoan<'_> {
     /// Publishes the frame and wakes the subscribers; returns how many received it.
     pub fn send(self) -> Result<usize> {
         let topic = self.publisher.topic;
-        let n = self
-            .sample
-            .send()
-            .map_err(|e| BusError::topic(topic, "cannot send a frame", e))?;
-        self.publisher
-            .notifier
-            .notify()
-            .map_err(|e| BusError::topic(topic, "cannot notify", e))?;
+        let n = self.sample.send().map_err(|e| BusError::topic(topic, "cannot send a frame", e))?;
+        self.publisher.notifier.notify().map_err(|e| BusError::topic(topic, "cannot notify", e))?;
         Ok(n)
     }
 }
@@ -151,11 +134,7 @@ impl FrameSubscriber {
     /// pending wake-ups are consumed before `None` is reported, so a frame sent later wakes the
     /// waiter again.
     pub fn take(&self) -> Result<Option<Frame>> {
-        let receive = || {
-            self.port
-                .receive()
-                .map_err(|e| BusError::topic(self.topic, "cannot receive", e))
-        };
+        let receive = || self.port.receive().map_err(|e| BusError::topic(self.topic, "cannot receive", e));
         if let Some(sample) = receive()? {
             return Ok(Some(Frame { sample }));
         }
@@ -175,11 +154,7 @@ impl FrameSubscriber {
 
 impl Bus {
     /// A frame publisher whose shared memory is sized for frames of at most `max_frame_bytes`.
-    pub fn frame_publisher(
-        &self,
-        topic: FrameTopic,
-        max_frame_bytes: usize,
-    ) -> Result<FramePublisher> {
+    pub fn frame_publisher(&self, topic: FrameTopic, max_frame_bytes: usize) -> Result<FramePublisher> {
         let service = open_frame_service(self, topic)?;
         let port = service
             .publisher_builder()
@@ -191,12 +166,7 @@ impl Bus {
             .notifier_builder()
             .create()
             .map_err(|e| BusError::topic(topic.name, "cannot create a notifier", e))?;
-        Ok(FramePublisher {
-            topic: topic.name,
-            max_frame_bytes,
-            port,
-            notifier,
-        })
+        Ok(FramePublisher { topic: topic.name, max_frame_bytes, port, notifier })
     }
 
     pub fn frame_subscriber(&self, topic: FrameTopic) -> Result<FrameSubscriber> {
@@ -210,10 +180,6 @@ impl Bus {
             .listener_builder()
             .create()
             .map_err(|e| BusError::topic(topic.name, "cannot create a listener", e))?;
-        Ok(FrameSubscriber {
-            topic: topic.name,
-            port,
-            listener,
-        })
+        Ok(FrameSubscriber { topic: topic.name, port, listener })
     }
 }

@@ -15,10 +15,7 @@ use crate::{Bus, BusError, Result};
 pub(crate) fn open_error(topic: &str, e: PublishSubscribeOpenOrCreateError) -> BusError {
     let detail = format!("{e:?}");
     if detail.contains("Incompatible") || detail.contains("DoesNotSupport") {
-        BusError::IncompatibleTopic {
-            topic: topic.to_owned(),
-            detail,
-        }
+        BusError::IncompatibleTopic { topic: topic.to_owned(), detail }
     } else {
         BusError::topic(topic, "cannot open or create the topic", e)
     }
@@ -82,11 +79,7 @@ impl<T: Message> Publisher<T> {
             .notifier_builder()
             .create()
             .map_err(|e| BusError::topic(topic.name, "cannot create a notifier", e))?;
-        Ok(Self {
-            topic: topic.name,
-            port,
-            notifier,
-        })
+        Ok(Self { topic: topic.name, port, notifier })
     }
 
     pub fn topic(&self) -> &'static str {
@@ -95,17 +88,11 @@ impl<T: Message> Publisher<T> {
 
     /// Sends one message and wakes the subscribers. Returns how many subscribers received it.
     pub fn send(&self, msg: &T) -> Result<usize> {
-        let sample = self
-            .port
-            .loan_uninit()
-            .map_err(|e| BusError::topic(self.topic, "cannot loan a sample", e))?;
-        let receivers = sample
-            .write_payload(*msg)
-            .send()
-            .map_err(|e| BusError::topic(self.topic, "cannot send", e))?;
-        self.notifier
-            .notify()
-            .map_err(|e| BusError::topic(self.topic, "cannot notify", e))?;
+        let sample =
+            self.port.loan_uninit().map_err(|e| BusError::topic(self.topic, "cannot loan a sample", e))?;
+        let receivers =
+            sample.write_payload(*msg).send().map_err(|e| BusError::topic(self.topic, "cannot send", e))?;
+        self.notifier.notify().map_err(|e| BusError::topic(self.topic, "cannot notify", e))?;
         Ok(receivers)
     }
 }
@@ -130,11 +117,7 @@ impl<T: Message> Subscriber<T> {
             .listener_builder()
             .create()
             .map_err(|e| BusError::topic(topic.name, "cannot create a listener", e))?;
-        Ok(Self {
-            topic: topic.name,
-            port,
-            listener,
-        })
+        Ok(Self { topic: topic.name, port, listener })
     }
 
     pub fn topic(&self) -> &'static str {
@@ -147,10 +130,8 @@ impl<T: Message> Subscriber<T> {
     pub fn drain(&self, mut f: impl FnMut(&T)) -> Result<usize> {
         let mut n = 0;
         let mut receive_all = |n: &mut usize| -> Result<()> {
-            while let Some(sample) = self
-                .port
-                .receive()
-                .map_err(|e| BusError::topic(self.topic, "cannot receive", e))?
+            while let Some(sample) =
+                self.port.receive().map_err(|e| BusError::topic(self.topic, "cannot receive", e))?
             {
                 f(sample.payload());
                 *n += 1;
@@ -161,6 +142,13 @@ impl<T: Message> Subscriber<T> {
         crate::waiter::consume_events(&self.listener, self.topic)?;
         receive_all(&mut n)?;
         Ok(n)
+    }
+
+    /// Replaces the contents of `out` with every queued message, oldest first; reuse `out` across
+    /// wake-ups so the loop does not allocate.
+    pub fn drain_into(&self, out: &mut Vec<T>) -> Result<usize> {
+        out.clear();
+        self.drain(|m| out.push(*m))
     }
 
     /// The newest queued message, discarding older ones.

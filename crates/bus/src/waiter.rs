@@ -76,10 +76,7 @@ impl Waitable for FdSource {
 }
 
 pub(crate) fn consume_events(listener: &Listener<ipc::Service>, topic: &str) -> Result<()> {
-    listener
-        .try_wait(|_| {})
-        .map(|_| ())
-        .map_err(|e| BusError::topic(topic, "cannot consume wake-ups", e))
+    listener.try_wait(|_| {}).map(|_| ()).map_err(|e| BusError::topic(topic, "cannot consume wake-ups", e))
 }
 
 /// Keeps a subscriber or timer attached to a [`Waiter`]; detaches on drop.

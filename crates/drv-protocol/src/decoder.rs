@@ -26,10 +26,7 @@ pub struct Decoder {
 
 impl Decoder {
     pub fn new() -> Self {
-        Self {
-            buf: Vec::with_capacity(MAX_FRAME_LEN),
-            ..Self::default()
-        }
+        Self { buf: Vec::with_capacity(MAX_FRAME_LEN), ..Self::default() }
     }
 
     pub fn stats(&self) -> DecoderStats {
@@ -42,9 +39,7 @@ impl Decoder {
             if b == b'$' {
                 if self.in_frame {
                     self.stats.truncated += 1;
-                    out(Err(FrameError::Malformed(
-                        "frame cut short by the next `$`".into(),
-                    )));
+                    out(Err(FrameError::Malformed("frame cut short by the next `$`".into())));
                 }
                 self.in_frame = true;
                 self.buf.clear();
@@ -62,9 +57,7 @@ impl Decoder {
             if self.buf.len() + 2 >= MAX_FRAME_LEN {
                 self.in_frame = false;
                 self.stats.truncated += 1;
-                out(Err(FrameError::Malformed(format!(
-                    "frame longer than {MAX_FRAME_LEN} bytes"
-                ))));
+                out(Err(FrameError::Malformed(format!("frame longer than {MAX_FRAME_LEN} bytes"))));
                 continue;
             }
             self.buf.push(b);
@@ -103,20 +96,10 @@ mod tests {
 
     fn samples() -> Vec<Line> {
         vec![
-            Line::Command(Command::Move {
-                id: 7,
-                hundredths_ft: -123,
-            }),
-            Line::Command(Command::Turn {
-                id: 8,
-                tenths_deg: 900,
-            }),
+            Line::Command(Command::Move { id: 7, hundredths_ft: -123 }),
+            Line::Command(Command::Turn { id: 8, tenths_deg: 900 }),
             Line::Command(Command::Stop { id: 9 }),
-            Line::Command(Command::Velocity {
-                id: 10,
-                hundredths_ft_per_s: 5,
-                tenths_deg_per_s: -30,
-            }),
+            Line::Command(Command::Velocity { id: 10, hundredths_ft_per_s: 5, tenths_deg_per_s: -30 }),
             Line::Report(Report::Encoders {
                 time_ms: 123_456,
                 x_hundredths_ft: 10,
@@ -131,10 +114,7 @@ mod tests {
                 ranges_tenths_ft: [0, 1, 2, 30, 255, 254, 7, 100],
             }),
             Line::Report(Report::Ack { id: 3 }),
-            Line::Report(Report::Nak {
-                id: 4,
-                reason: crate::NakReason::OutOfRange,
-            }),
+            Line::Report(Report::Nak { id: 4, reason: crate::NakReason::OutOfRange }),
         ]
     }
 
@@ -143,13 +123,7 @@ mod tests {
         let bytes: String = samples().iter().map(encode).collect();
         let (lines, stats) = decode_all(bytes.as_bytes());
         assert_eq!(lines, samples());
-        assert_eq!(
-            stats,
-            DecoderStats {
-                frames: 8,
-                ..DecoderStats::default()
-            }
-        );
+        assert_eq!(stats, DecoderStats { frames: 8, ..DecoderStats::default() });
     }
 
     #[test]
@@ -179,10 +153,7 @@ mod tests {
         let mut d = Decoder::new();
         let mut results = Vec::new();
         d.push(&text, |r| results.push(r));
-        assert!(matches!(
-            results.as_slice(),
-            [Err(FrameError::Checksum { .. })]
-        ));
+        assert!(matches!(results.as_slice(), [Err(FrameError::Checksum { .. })]));
         assert_eq!(d.stats().bad_checksums, 1);
     }
 
@@ -212,10 +183,7 @@ mod tests {
             let mut d = Decoder::new();
             let mut results = Vec::new();
             d.push(frame.as_bytes(), |r| results.push(r));
-            assert!(
-                matches!(results.as_slice(), [Err(FrameError::Malformed(_))]),
-                "{body}: {results:?}"
-            );
+            assert!(matches!(results.as_slice(), [Err(FrameError::Malformed(_))]), "{body}: {results:?}");
         }
     }
 }

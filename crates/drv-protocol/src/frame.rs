@@ -16,11 +16,7 @@ pub enum Command {
     /// Stop at once, abandoning any motion.
     Stop { id: u32 },
     /// Drive at a steady speed until the next command.
-    Velocity {
-        id: u32,
-        hundredths_ft_per_s: i32,
-        tenths_deg_per_s: i32,
-    },
+    Velocity { id: u32, hundredths_ft_per_s: i32, tenths_deg_per_s: i32 },
 }
 
 /// DRV → host.
@@ -36,11 +32,7 @@ pub enum Report {
         command_id: u32,
     },
     /// One bank of eight sensors fired together; sensor `bank + 3 * i` read `ranges[i]`.
-    Sonar {
-        time_ms: u64,
-        bank: u8,
-        ranges_tenths_ft: [u16; 8],
-    },
+    Sonar { time_ms: u64, bank: u8, ranges_tenths_ft: [u16; 8] },
     /// A command was accepted.
     Ack { id: u32 },
     /// A command was refused; `reason` is a short word.
@@ -84,11 +76,7 @@ pub fn encode(line: &Line) -> String {
         }
         Line::Command(Command::Turn { id, tenths_deg }) => write!(body, "TN {id} {tenths_deg}"),
         Line::Command(Command::Stop { id }) => write!(body, "ST {id}"),
-        Line::Command(Command::Velocity {
-            id,
-            hundredths_ft_per_s,
-            tenths_deg_per_s,
-        }) => {
+        Line::Command(Command::Velocity { id, hundredths_ft_per_s, tenths_deg_per_s }) => {
             write!(body, "VL {id} {hundredths_ft_per_s} {tenths_deg_per_s}")
         }
         Line::Report(Report::Encoders {
@@ -105,15 +93,9 @@ pub fn encode(line: &Line) -> String {
                 u8::from(*moving)
             )
         }
-        Line::Report(Report::Sonar {
-            time_ms,
-            bank,
-            ranges_tenths_ft,
-        }) => {
+        Line::Report(Report::Sonar { time_ms, bank, ranges_tenths_ft }) => {
             let _ = write!(body, "SN {time_ms} {bank}");
-            ranges_tenths_ft
-                .iter()
-                .try_for_each(|r| write!(body, " {r}"))
+            ranges_tenths_ft.iter().try_for_each(|r| write!(body, " {r}"))
         }
         Line::Report(Report::Ack { id }) => write!(body, "AK {id}"),
         Line::Report(Report::Nak { id, reason }) => write!(
@@ -131,10 +113,7 @@ pub fn encode(line: &Line) -> String {
 /// Parses the bytes between `$` and `\r\n` (exclusive): `BODY*CS`.
 pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
     let bad = |why: &str| FrameError::Malformed(why.to_owned());
-    let star = inner
-        .iter()
-        .rposition(|&b| b == b'*')
-        .ok_or_else(|| bad("no `*` before checksum"))?;
+    let star = inner.iter().rposition(|&b| b == b'*').ok_or_else(|| bad("no `*` before checksum"))?;
     let (body, cs) = (&inner[..star], &inner[star + 1..]);
     let cs = std::str::from_utf8(cs)
         .ok()
@@ -153,18 +132,13 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
         nums.get(i)
             .ok_or_else(|| FrameError::Malformed(format!("`{tag}` lacks field {}", i + 1)))?
             .parse::<i64>()
-            .map_err(|_| {
-                FrameError::Malformed(format!("`{tag}` field {} is not an integer", i + 1))
-            })
+            .map_err(|_| FrameError::Malformed(format!("`{tag}` field {} is not an integer", i + 1)))
     };
     let arity = |n: usize| -> Result<(), FrameError> {
         if nums.len() == n {
             Ok(())
         } else {
-            Err(FrameError::Malformed(format!(
-                "`{tag}` takes {n} fields, got {}",
-                nums.len()
-            )))
+            Err(FrameError::Malformed(format!("`{tag}` takes {n} fields, got {}", nums.len())))
         }
     };
     let fit = |v: i64, what: &str| -> Result<i32, FrameError> {
@@ -175,17 +149,11 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
     Ok(match tag {
         "MV" => {
             arity(2)?;
-            Line::Command(Command::Move {
-                id: id(0)?,
-                hundredths_ft: fit(num(1)?, "distance")?,
-            })
+            Line::Command(Command::Move { id: id(0)?, hundredths_ft: fit(num(1)?, "distance")? })
         }
         "TN" => {
             arity(2)?;
-            Line::Command(Command::Turn {
-                id: id(0)?,
-                tenths_deg: fit(num(1)?, "angle")?,
-            })
+            Line::Command(Command::Turn { id: id(0)?, tenths_deg: fit(num(1)?, "angle")? })
         }
         "ST" => {
             arity(1)?;
@@ -228,11 +196,7 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
                     .filter(|r| *r <= SONAR_NO_ECHO)
                     .ok_or_else(|| bad("`SN` range above 255"))?;
             }
-            Line::Report(Report::Sonar {
-                time_ms: time(0)?,
-                bank,
-                ranges_tenths_ft,
-            })
+            Line::Report(Report::Sonar { time_ms: time(0)?, bank, ranges_tenths_ft })
         }
         "AK" => {
             arity(1)?;
@@ -244,18 +208,13 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
                 "RANGE" => NakReason::OutOfRange,
                 "BUSY" => NakReason::Busy,
                 other => {
-                    return Err(FrameError::Malformed(format!(
-                        "`NK` reason `{other}` unknown"
-                    )));
+                    return Err(FrameError::Malformed(format!("`NK` reason `{other}` unknown")));
                 }
             };
             Line::Report(Report::Nak { id: id(0)?, reason })
         }
         other => {
-            return Err(FrameError::Malformed(format!(
-                "unknown tag `{}`",
-                other.escape_debug()
-            )));
+            return Err(FrameError::Malformed(format!("unknown tag `{}`", other.escape_debug())));
         }
     })
 }

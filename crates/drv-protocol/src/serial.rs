@@ -18,9 +18,7 @@ pub fn make_raw(fd: impl AsFd) -> io::Result<()> {
 pub fn set_nonblocking(fd: impl AsFd) -> io::Result<()> {
     let flags = fcntl(&fd, FcntlArg::F_GETFL).map_err(io::Error::from)?;
     let flags = OFlag::from_bits_truncate(flags) | OFlag::O_NONBLOCK;
-    fcntl(&fd, FcntlArg::F_SETFL(flags))
-        .map(|_| ())
-        .map_err(io::Error::from)
+    fcntl(&fd, FcntlArg::F_SETFL(flags)).map(|_| ()).map_err(io::Error::from)
 }
 
 /// Reads everything available now into `buf` (cleared first). `Ok(false)`: the line hung up.

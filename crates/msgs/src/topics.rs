@@ -23,23 +23,11 @@ pub struct Qos {
 
 impl Qos {
     /// Small fixed-size messages: a few consumers plus the recorder and tools.
-    pub const STATE: Qos = Qos {
-        buffer: 16,
-        borrowed: 2,
-        history: 1,
-        max_publishers: 2,
-        max_subscribers: 8,
-    };
+    pub const STATE: Qos = Qos { buffer: 16, borrowed: 2, history: 1, max_publishers: 4, max_subscribers: 8 };
     /// Camera frames: every slot costs a whole frame of shared memory, so keep them few:
     /// 3 subscribers x (2 queued + 1 held) + 1 loaned = 10 frames (62 MB at 1080p rgb8,
     /// 3 MB at 640x480 mono8).
-    pub const FRAMES: Qos = Qos {
-        buffer: 2,
-        borrowed: 1,
-        history: 0,
-        max_publishers: 1,
-        max_subscribers: 3,
-    };
+    pub const FRAMES: Qos = Qos { buffer: 2, borrowed: 1, history: 0, max_publishers: 1, max_subscribers: 3 };
 }
 
 /// A typed topic of fixed-size messages.
@@ -59,11 +47,7 @@ impl<T> Copy for Topic<T> {}
 
 impl<T> Topic<T> {
     pub const fn new(name: &'static str, qos: Qos) -> Self {
-        Self {
-            name,
-            qos,
-            _payload: PhantomData,
-        }
+        Self { name, qos, _payload: PhantomData }
     }
 }
 
@@ -83,10 +67,7 @@ pub const ODOMETRY: Topic<Odometry> = Topic::new("odometry", Qos::STATE);
 pub const VISION_DETECTIONS: Topic<Detections> = Topic::new("vision/detections", Qos::STATE);
 pub const UMS_MAP: Topic<UncertaintyMap> = Topic::new("ums/map", Qos::STATE);
 pub const EXECUTIVE_STATUS: Topic<MissionStatus> = Topic::new("executive/status", Qos::STATE);
-pub const CAMERA_FRAME: FrameTopic = FrameTopic {
-    name: "camera/frame",
-    qos: Qos::FRAMES,
-};
+pub const CAMERA_FRAME: FrameTopic = FrameTopic { name: "camera/frame", qos: Qos::FRAMES };
 
 /// Every topic's name; the recorder must record each of them.
 pub const ALL: &[&str] = &[
@@ -113,15 +94,8 @@ mod tests {
         names.dedup();
         assert_eq!(names.len(), ALL.len(), "a topic name is listed twice");
         for name in ALL {
-            assert!(
-                !name.is_empty() && !name.starts_with('/') && !name.ends_with('/'),
-                "{name}"
-            );
-            assert!(
-                name.chars()
-                    .all(|c| c.is_ascii_lowercase() || "_/".contains(c)),
-                "{name}"
-            );
+            assert!(!name.is_empty() && !name.starts_with('/') && !name.ends_with('/'), "{name}");
+            assert!(name.chars().all(|c| c.is_ascii_lowercase() || "_/".contains(c)), "{name}");
         }
     }
 }

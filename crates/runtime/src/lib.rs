@@ -21,15 +21,9 @@ pub fn init_logging() {
     let supervised = std::env::var_os(SUPERVISED_ENV).is_some();
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
         .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
-    let builder = tracing_subscriber::fmt()
-        .with_env_filter(filter)
-        .with_writer(std::io::stderr);
+    let builder = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr);
     if supervised {
-        builder
-            .without_time()
-            .with_ansi(false)
-            .with_target(false)
-            .init();
+        builder.without_time().with_ansi(false).with_target(false).init();
     } else {
         builder.init();
     }
@@ -51,8 +45,7 @@ pub fn notify_ready() -> anyhow::Result<()> {
     // SAFETY: the supervisor opened this descriptor for us alone and nothing else in the
     // process uses it; the File takes ownership and closes it.
     let mut pipe = unsafe { std::fs::File::from_raw_fd(fd) };
-    pipe.write_all(READY_LINE)
-        .map_err(|e| anyhow::anyhow!("writing readiness to fd {fd}: {e}"))?;
+    pipe.write_all(READY_LINE).map_err(|e| anyhow::anyhow!("writing readiness to fd {fd}: {e}"))?;
     tracing::debug!("ready");
     Ok(())
 }

@@ -15,10 +15,8 @@ pub use raycast::Hit;
 impl World {
     /// Loads a world file; errors name the file, line and field.
     pub fn load(path: &std::path::Path) -> Result<World, WorldError> {
-        let text = std::fs::read_to_string(path).map_err(|e| WorldError::Io {
-            file: path.display().to_string(),
-            detail: e.to_string(),
-        })?;
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| WorldError::Io { file: path.display().to_string(), detail: e.to_string() })?;
         load_str(&text, &path.display().to_string())
     }
 }

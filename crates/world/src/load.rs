@@ -9,22 +9,13 @@ pub enum WorldError {
     #[error("{file}: {detail}")]
     Io { file: String, detail: String },
     #[error("{file}:{line}: field `{field}`: {detail}")]
-    Parse {
-        file: String,
-        line: usize,
-        field: String,
-        detail: String,
-    },
+    Parse { file: String, line: usize, field: String, detail: String },
     #[error("{file}: inconsistent world: {detail}")]
     Inconsistent { file: String, detail: String },
 }
 
 fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())]
-        .bytes()
-        .filter(|&b| b == b'\n')
-        .count()
-        + 1
+    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
 }
 
 /// Parses a world from `text`; `file` names it in errors.
@@ -34,17 +25,9 @@ pub fn load_str(text: &str, file: &str) -> Result<World, WorldError> {
         let field = e.path().to_string();
         let inner = e.into_inner();
         let line = inner.span().map_or(0, |s| line_of(text, s.start));
-        WorldError::Parse {
-            file: file.to_owned(),
-            line,
-            field,
-            detail: inner.message().to_owned(),
-        }
+        WorldError::Parse { file: file.to_owned(), line, field, detail: inner.message().to_owned() }
     })?;
-    check(&world).map_err(|detail| WorldError::Inconsistent {
-        file: file.to_owned(),
-        detail,
-    })?;
+    check(&world).map_err(|detail| WorldError::Inconsistent { file: file.to_owned(), detail })?;
     Ok(world)
 }
 
@@ -96,29 +79,15 @@ mod tests {
     #[test]
     fn a_bad_value_names_line_and_field() {
         let text = HALLWAY.replacen("height_m = 1.2", "height_m = \"tall\"", 1);
-        let line = text
-            .lines()
-            .position(|l| l.contains("\"tall\""))
-            .expect("edited")
-            + 1;
-        let err = load_str(&text, "w.toml")
-            .expect_err("must fail")
-            .to_string();
-        assert!(
-            err.starts_with(&format!("w.toml:{line}: field `camera.height_m`")),
-            "{err}"
-        );
+        let line = text.lines().position(|l| l.contains("\"tall\"")).expect("edited") + 1;
+        let err = load_str(&text, "w.toml").expect_err("must fail").to_string();
+        assert!(err.starts_with(&format!("w.toml:{line}: field `camera.height_m`")), "{err}");
     }
 
     #[test]
     fn an_unknown_ground_is_inconsistent() {
         let text = HALLWAY.replacen("ground = \"tile\"", "ground = \"ice\"", 1);
-        let err = load_str(&text, "w.toml")
-            .expect_err("must fail")
-            .to_string();
-        assert!(
-            err.contains("ground `ice` is not in the terrain table"),
-            "{err}"
-        );
+        let err = load_str(&text, "w.toml").expect_err("must fail").to_string();
+        assert!(err.contains("ground `ice` is not in the terrain table"), "{err}");
     }
 }

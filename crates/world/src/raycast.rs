@@ -53,21 +53,14 @@ mod tests {
     fn rays_hit_the_nearest_wall_with_the_right_incidence() {
         let w = load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads");
         // Straight across the corridor from its centre line: head-on.
-        let hit = w
-            .cast_ray([2.0, 0.0], [0.0, 1.0], 100.0)
-            .expect("hits the left wall");
+        let hit = w.cast_ray([2.0, 0.0], [0.0, 1.0], 100.0).expect("hits the left wall");
         assert!((hit.distance_m - 1.0).abs() < 1e-9, "{hit:?}");
         assert!(hit.incidence_rad.abs() < 1e-9);
         // At 60 degrees off the normal the distance is 1 / cos 60 = 2.
         let a = 30f64.to_radians();
-        let hit = w
-            .cast_ray([2.0, 0.0], [a.cos(), a.sin()], 100.0)
-            .expect("hits");
+        let hit = w.cast_ray([2.0, 0.0], [a.cos(), a.sin()], 100.0).expect("hits");
         assert!((hit.distance_m - 2.0).abs() < 1e-9, "{hit:?}");
         assert!((hit.incidence_rad - 60f64.to_radians()).abs() < 1e-9);
-        assert!(
-            w.cast_ray([2.0, 0.0], [0.0, 1.0], 0.5).is_none(),
-            "beyond max range"
-        );
+        assert!(w.cast_ray([2.0, 0.0], [0.0, 1.0], 0.5).is_none(), "beyond max range");
     }
 }

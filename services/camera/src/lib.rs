@@ -1,1 +1,155 @@
-//! Camera: renders the simulated world into shared-memory frames.
+//! The camera's renderer: ray casting the world's walls and floor from a pose through a pinhole
+//! camera, pixel = illumination x reflectance, written straight into the caller's buffer (the
+//! loaned shared-memory slice).
+
+use harvey_msgs::Encoding;
+use harvey_world::World;
+
+/// One image column's ray: its direction and the wall it meets.
+#[derive(Debug, Clone, Copy, Default)]
+struct Column {
+    dir: [f64; 2],
+    cos_off_axis: f64,
+    /// Depth along the optical axis of the wall hit, with the wall and position along it.
+    wall: Option<(f64, usize, f64)>,
+}
+
+/// Renders frames of one size; keeps its per-column scratch so frames allocate nothing.
+#[derive(Debug)]
+pub struct Renderer {
+    width_px: u32,
+    height_px: u32,
+    encoding: Encoding,
+    focal_px: f64,
+    columns: Vec<Column>,
+}
+
+impl Renderer {
+    /// A renderer for `width_px x height_px`; the world's focal length scales with the width.
+    pub fn new(world: &World, width_px: u32, height_px: u32, encoding: Encoding) -> Self {
+        let focal_px = world.camera.focal_px * f64::from(width_px) / f64::from(world.camera.width_px);
+        Self { width_px, height_px, encoding, focal_px, columns: vec![Column::default(); width_px as usize] }
+    }
+
+    pub fn frame_bytes(&self) -> usize {
+        (self.width_px * self.height_px * self.encoding.bytes_per_pixel()) as usize
+    }
+
+    pub fn width_px(&self) -> u32 {
+        self.width_px
+    }
+
+    pub fn height_px(&self) -> u32 {
+        self.height_px
+    }
+
+    pub fn encoding(&self) -> Encoding {
+        self.encoding
+    }
+
+    /// Renders the view from `(x_m, y_m, heading_rad)` into `out` (exactly `frame_bytes()` long).
+    pub fn render(&mut self, world: &World, pose: [f64; 3], out: &mut [u8]) -> Result<(), String> {
+        if out.len() != self.frame_bytes() {
+            return Err(format!("frame buffer is {} bytes, {} needed", out.len(), self.frame_bytes()));
+        }
+        let [x, y, heading] = pose;
+        if !(x.is_finite() && y.is_finite() && heading.is_finite()) {
+            return Err(format!("pose {pose:?} is not finite"));
+        }
+        let cx = f64::from(self.width_px) / 2.0;
+        for (u, col) in self.columns.iter_mut().enumerate() {
+            let off_axis = ((cx - u as f64 - 0.5) / self.focal_px).atan(); // left is positive
+            let a = heading + off_axis;
+            let dir = [a.cos(), a.sin()];
+            let cos_off_axis = off_axis.cos();
+            let wall =
+                world.cast_ray([x, y], dir, 1e3).map(|h| (h.distance_m * cos_off_axis, h.wall, h.along_m));
+            *col = Column { dir, cos_off_axis, wall };
+        }
+        let cam = &world.camera;
+        let floor = &world.floor;
+        let cy = f64::from(self.height_px) / 2.0;
+        let bpp = self.encoding.bytes_per_pixel() as usize;
+        let row_bytes = self.width_px as usize * bpp;
+        for (v, row) in out.chunks_exact_mut(row_bytes).enumerate() {
+            let down = (v as f64 + 0.5 - cy) / self.focal_px; // image y of this row, down positive
+            for (col, px) in self.columns.iter().zip(row.chunks_exact_mut(bpp)) {
+                let reflectance = match col.wall {
+                    Some((depth, wall, along)) => {
+                        let z = cam.height_m - down * depth;
+                        let w = &world.walls[wall];
+                        if (0.0..=w.height_m).contains(&z) {
+                            w.reflectance_at(along, z)
+                        } else if z < 0.0 {
+                            floor_at(world, [x, y], col, cam.height_m / down)
+                        } else {
+                            floor.ceiling_reflectance
+                        }
+                    }
+                    None if down > 0.0 => floor_at(world, [x, y], col, cam.height_m / down),
+                    None => floor.ceiling_reflectance,
+                };
+                px.fill((cam.illumination * reflectance).round().clamp(0.0, 255.0) as u8);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Reflectance of the floor tile seen at optical depth `depth_m` along a column.
+fn floor_at(world: &World, origin: [f64; 2], col: &Column, depth_m: f64) -> f64 {
+    let range = depth_m / col.cos_off_axis;
+    let p = [origin[0] + col.dir[0] * range, origin[1] + col.dir[1] * range];
+    let t = world.floor.tile_m;
+    let parity = ((p[0] / t).floor() as i64 + (p[1] / t).floor() as i64).rem_euclid(2) as usize;
+    world.floor.reflectance[parity]
+}
+
+/// FNV-1a over a frame: a cheap fingerprint to compare frames across processes.
+pub fn checksum(pixels: &[u8]) -> u64 {
+    pixels.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hallway() -> World {
+        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
+    }
+
+    #[test]
+    fn walls_floor_and_ceiling_have_their_reflectances() {
+        let w = hallway();
+        let mut r = Renderer::new(&w, 640, 480, Encoding::Mono8);
+        let mut img = vec![0u8; r.frame_bytes()];
+        r.render(&w, [5.0, 0.0, 0.0], &mut img).expect("renders");
+        let at = |u: usize, v: usize| img[v * 640 + u];
+        let lit = |refl: f64| (w.camera.illumination * refl).round() as u8;
+        // The end wall straight ahead, 11 m away, at camera height: the row through the centre.
+        assert_eq!(at(320, 240), lit(0.60));
+        // The top row looks at the ceiling, the bottom row at the floor tiles.
+        assert_eq!(at(320, 0), lit(w.floor.ceiling_reflectance));
+        assert!([lit(0.55), lit(0.40)].contains(&at(320, 479)));
+        // The left edge column looks at the left wall (reflectance 0.70) near camera height, 7.7 m
+        // along it, clear of its doors; its door at 4.0-4.9 m is darker (0.30) when seen from x = 2.
+        assert_eq!(at(0, 240), lit(0.70));
+        r.render(&w, [2.0, 0.0, 0.0], &mut img).expect("renders");
+        assert_eq!(img[240 * 640], lit(0.30));
+    }
+
+    #[test]
+    fn rgb_replicates_gray_and_sizes_are_checked() {
+        let w = hallway();
+        let mut mono = Renderer::new(&w, 64, 48, Encoding::Mono8);
+        let mut rgb = Renderer::new(&w, 64, 48, Encoding::Rgb8);
+        let mut a = vec![0u8; mono.frame_bytes()];
+        let mut b = vec![0u8; rgb.frame_bytes()];
+        mono.render(&w, [1.0, 0.2, 0.1], &mut a).expect("renders");
+        rgb.render(&w, [1.0, 0.2, 0.1], &mut b).expect("renders");
+        assert!(a.iter().zip(b.chunks_exact(3)).all(|(g, p)| p == [*g, *g, *g]));
+        assert!(mono.render(&w, [0.0, 0.0, 0.0], &mut b).is_err());
+        assert!(mono.render(&w, [f64::NAN, 0.0, 0.0], &mut a).is_err());
+        assert_ne!(checksum(&a), checksum(&a[1..]));
+    }
+}

@@ -1,2 +1,104 @@
-//! harvey-camera: process entry point.
-fn main() {}
+//! harvey-camera: renders the simulated world into loaned shared-memory frames, from the
+//! simulator's true pose (`sim/truth`), or from a fixed pose at a fixed rate (`--pose`).
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use anyhow::Context;
+use clap::Parser;
+use harvey_bus::{Bus, FramePublisher, Waiter, Wake};
+use harvey_camera::{Renderer, checksum};
+use harvey_msgs::{Encoding, FrameHeader, topics};
+use harvey_world::World;
+
+#[derive(Parser)]
+#[command(about = "Simulated camera rendering into shared memory")]
+struct Args {
+    #[arg(long)]
+    world: PathBuf,
+    /// Image size; defaults to the world's calibrated camera.
+    #[arg(long)]
+    width: Option<u32>,
+    #[arg(long)]
+    height: Option<u32>,
+    /// mono8 or rgb8.
+    #[arg(long, default_value = "mono8")]
+    encoding: String,
+    /// Render one frame per this many true-pose messages.
+    #[arg(long, default_value_t = 2)]
+    every: u64,
+    /// Render from this fixed pose `x_m,y_m,heading_deg` instead of following `sim/truth`.
+    #[arg(long, value_delimiter = ',', num_args = 3)]
+    pose: Option<Vec<f64>>,
+    /// With `--pose`: frames per second (wall clock), and how many to send (0: until stopped).
+    #[arg(long, default_value_t = 10.0)]
+    rate_hz: f64,
+    #[arg(long, default_value_t = 0)]
+    frames: u64,
+}
+
+struct Camera {
+    world: World,
+    renderer: Renderer,
+    publisher: FramePublisher,
+    seq: u64,
+}
+
+impl Camera {
+    fn shoot(&mut self, pose: [f64; 3], stamp_ns: u64) -> anyhow::Result<()> {
+        self.seq += 1;
+        let r = &self.renderer;
+        let header = FrameHeader::new(self.seq, stamp_ns, r.width_px(), r.height_px(), r.encoding());
+        let mut frame = self.publisher.loan(header)?;
+        self.renderer.render(&self.world, pose, frame.pixels_mut()).map_err(anyhow::Error::msg)?;
+        tracing::debug!(seq = self.seq, checksum = checksum(frame.pixels_mut()), "frame");
+        frame.send()?;
+        Ok(())
+    }
+}
+
+fn main() -> anyhow::Result<()> {
+    harvey_runtime::init_logging();
+    let args = Args::parse();
+    let world = World::load(&args.world)?;
+    let encoding = Encoding::parse(&args.encoding)
+        .with_context(|| format!("--encoding `{}`: expected mono8 or rgb8", args.encoding))?;
+    let width = args.width.unwrap_or(world.camera.width_px);
+    let height = args.height.unwrap_or(world.camera.height_px);
+    anyhow::ensure!(
+        width > 0 && height > 0 && width <= 8192 && height <= 8192,
+        "image size {width}x{height} out of range"
+    );
+    let renderer = Renderer::new(&world, width, height, encoding);
+    let bus = Bus::join("camera")?;
+    let publisher = bus.frame_publisher(topics::CAMERA_FRAME, renderer.frame_bytes())?;
+    let mut cam = Camera { world, renderer, publisher, seq: 0 };
+    let waiter = Waiter::new()?;
+
+    if let Some(p) = args.pose {
+        anyhow::ensure!(args.rate_hz > 0.0, "--rate-hz must be positive");
+        let pose = [p[0], p[1], p[2].to_radians()];
+        let _tick = waiter.attach_interval(Duration::from_secs_f64(1.0 / args.rate_hz))?;
+        harvey_runtime::notify_ready()?;
+        let period_ns = (1e9 / args.rate_hz) as u64;
+        while waiter.wait(None)? != Wake::Shutdown && (args.frames == 0 || cam.seq < args.frames) {
+            cam.shoot(pose, (cam.seq + 1) * period_ns)?;
+        }
+        return Ok(());
+    }
+
+    let truth = bus.subscriber(topics::SIM_TRUTH)?;
+    let _a = waiter.attach(&truth)?;
+    harvey_runtime::notify_ready()?;
+    let every = args.every.max(1);
+    let mut poses = Vec::new();
+    while waiter.wait(None)? != Wake::Shutdown {
+        truth.drain_into(&mut poses)?;
+        for t in poses.iter().filter(|t| t.header.seq % every == 0) {
+            let p = t.world_from_robot;
+            cam.shoot([p.x_m, p.y_m, p.heading_rad], t.header.stamp_ns)?;
+        }
+    }
+    tracing::info!(frames = cam.seq, "camera stopped");
+    Ok(())
+}

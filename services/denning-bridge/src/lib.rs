@@ -21,69 +21,31 @@ pub enum Refusal {
     #[error("command {id}: {field} is not a finite number")]
     NotFinite { id: u32, field: &'static str },
     #[error("command {id}: {field} = {value:.3} is beyond the vehicle's limit of {limit}")]
-    OutOfRange {
-        id: u32,
-        field: &'static str,
-        value: f64,
-        limit: f64,
-    },
+    OutOfRange { id: u32, field: &'static str, value: f64, limit: f64 },
 }
 
 /// Converts a bus command to the DRV's, or says why it must not be sent.
 pub fn to_drv(cmd: &MotionCommand) -> Result<Command, Refusal> {
     let id = cmd.command_id;
-    let kind = cmd
-        .kind()
-        .ok_or(Refusal::UnknownKind { id, kind: cmd.kind })?;
+    let kind = cmd.kind().ok_or(Refusal::UnknownKind { id, kind: cmd.kind })?;
     let finite = |field, v: f64| {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(Refusal::NotFinite { id, field })
-        }
+        if v.is_finite() { Ok(v) } else { Err(Refusal::NotFinite { id, field }) }
     };
     let within = |field, value: f64, limit: f64| {
-        if value.abs() <= limit {
-            Ok(value)
-        } else {
-            Err(Refusal::OutOfRange {
-                id,
-                field,
-                value,
-                limit,
-            })
-        }
+        if value.abs() <= limit { Ok(value) } else { Err(Refusal::OutOfRange { id, field, value, limit }) }
     };
     Ok(match kind {
         CommandKind::Stop => Command::Stop { id },
         CommandKind::Move => {
-            let ft = within(
-                "distance_ft",
-                finite("distance_m", cmd.distance_m)? / FT,
-                MAX_MOVE_FT,
-            )?;
-            Command::Move {
-                id,
-                hundredths_ft: (ft * 100.0).round() as i32,
-            }
+            let ft = within("distance_ft", finite("distance_m", cmd.distance_m)? / FT, MAX_MOVE_FT)?;
+            Command::Move { id, hundredths_ft: (ft * 100.0).round() as i32 }
         }
         CommandKind::Turn => {
-            let deg = within(
-                "angle_deg",
-                finite("angle_rad", cmd.angle_rad)?.to_degrees(),
-                MAX_TURN_DEG,
-            )?;
-            Command::Turn {
-                id,
-                tenths_deg: (deg * 10.0).round() as i32,
-            }
+            let deg = within("angle_deg", finite("angle_rad", cmd.angle_rad)?.to_degrees(), MAX_TURN_DEG)?;
+            Command::Turn { id, tenths_deg: (deg * 10.0).round() as i32 }
         }
         CommandKind::Velocity => {
-            let v = within(
-                "speed_ft_per_s",
-                finite("linear_mps", cmd.linear_mps)? / FT,
-                MAX_SPEED_FT_PER_S,
-            )?;
+            let v = within("speed_ft_per_s", finite("linear_mps", cmd.linear_mps)? / FT, MAX_SPEED_FT_PER_S)?;
             let w = within(
                 "rate_deg_per_s",
                 finite("angular_radps", cmd.angular_radps)?.to_degrees(),
@@ -101,10 +63,7 @@ pub fn to_drv(cmd: &MotionCommand) -> Result<Command, Refusal> {
 /// Picks what to send from a batch of commands that arrived together: an urgent stop pre-empts
 /// everything else in the batch; otherwise all, in order.
 pub fn prioritise(batch: &[MotionCommand]) -> Vec<MotionCommand> {
-    match batch
-        .iter()
-        .find(|c| c.urgent != 0 && c.kind() == Some(CommandKind::Stop))
-    {
+    match batch.iter().find(|c| c.urgent != 0 && c.kind() == Some(CommandKind::Stop)) {
         Some(stop) => vec![*stop],
         None => batch.to_vec(),
     }
@@ -153,11 +112,7 @@ impl Bridge {
                     command_id,
                 })
             }
-            Report::Sonar {
-                time_ms,
-                bank,
-                ranges_tenths_ft,
-            } => {
+            Report::Sonar { time_ms, bank, ranges_tenths_ft } => {
                 self.sonar_seq += 1;
                 let mut echo_mask = 0;
                 let range_m = std::array::from_fn(|i| {
@@ -185,30 +140,18 @@ mod tests {
     use super::*;
 
     fn cmd(kind: CommandKind, distance_m: f64, angle_rad: f64) -> MotionCommand {
-        MotionCommand {
-            kind: kind as u32,
-            distance_m,
-            angle_rad,
-            command_id: 4,
-            ..Default::default()
-        }
+        MotionCommand { kind: kind as u32, distance_m, angle_rad, command_id: 4, ..Default::default() }
     }
 
     #[test]
     fn si_commands_become_drv_units() {
         assert_eq!(
             to_drv(&cmd(CommandKind::Move, 3.048, 0.0)),
-            Ok(Command::Move {
-                id: 4,
-                hundredths_ft: 1000
-            })
+            Ok(Command::Move { id: 4, hundredths_ft: 1000 })
         );
         assert_eq!(
             to_drv(&cmd(CommandKind::Turn, 0.0, -std::f64::consts::FRAC_PI_2)),
-            Ok(Command::Turn {
-                id: 4,
-                tenths_deg: -900
-            })
+            Ok(Command::Turn { id: 4, tenths_deg: -900 })
         );
     }
 
@@ -216,35 +159,20 @@ mod tests {
     fn impossible_commands_are_refused() {
         assert!(matches!(
             to_drv(&cmd(CommandKind::Move, 1609.0, 0.0)),
-            Err(Refusal::OutOfRange {
-                field: "distance_ft",
-                ..
-            })
+            Err(Refusal::OutOfRange { field: "distance_ft", .. })
         ));
         assert!(matches!(
             to_drv(&cmd(CommandKind::Turn, 0.0, f64::NAN)),
-            Err(Refusal::NotFinite {
-                field: "angle_rad",
-                ..
-            })
+            Err(Refusal::NotFinite { field: "angle_rad", .. })
         ));
-        let bad = MotionCommand {
-            kind: 77,
-            ..Default::default()
-        };
-        assert!(matches!(
-            to_drv(&bad),
-            Err(Refusal::UnknownKind { kind: 77, .. })
-        ));
+        let bad = MotionCommand { kind: 77, ..Default::default() };
+        assert!(matches!(to_drv(&bad), Err(Refusal::UnknownKind { kind: 77, .. })));
     }
 
     #[test]
     fn an_urgent_stop_preempts_its_batch() {
         let mv = cmd(CommandKind::Move, 1.0, 0.0);
-        let stop = MotionCommand {
-            urgent: 1,
-            ..cmd(CommandKind::Stop, 0.0, 0.0)
-        };
+        let stop = MotionCommand { urgent: 1, ..cmd(CommandKind::Stop, 0.0, 0.0) };
         assert_eq!(prioritise(&[mv, stop, mv]), vec![stop]);
         assert_eq!(prioritise(&[mv, mv]).len(), 2);
     }
@@ -257,13 +185,8 @@ mod tests {
             bank: 1,
             ranges_tenths_ft: [10, 255, 0, 0, 0, 0, 0, 0],
         });
-        let Outgoing::Sonar(s) = out else {
-            panic!("{out:?}")
-        };
-        assert_eq!(
-            (s.header.stamp_ns, s.bank, s.echo_mask & 0b11),
-            (150_000_000, 1, 0b01)
-        );
+        let Outgoing::Sonar(s) = out else { panic!("{out:?}") };
+        assert_eq!((s.header.stamp_ns, s.bank, s.echo_mask & 0b11), (150_000_000, 1, 0b01));
         assert!((s.range_m[0] - 0.3048).abs() < 1e-6);
     }
 }

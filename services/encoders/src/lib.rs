@@ -1,1 +1,102 @@
-//! Encoders: DRV shaft-encoder reports to odometry with the commanded motion.
+//! The encoders service's logic (001 §4, §6.1): shaft-encoder reports become odometry that
+//! carries the commanded motion and the progress made on it, for the UMS's growth and the
+//! executive's monitoring.
+
+use harvey_msgs::{EncodersRaw, Header, MotionCommand, Odometry, Pose2};
+
+/// Odometry state: the last command and where the encoders stood when the DRV accepted it.
+#[derive(Debug, Default)]
+pub struct OdometryBuilder {
+    command: MotionCommand,
+    /// Encoder pose when the current command was first reported as accepted.
+    start: Option<Pose2>,
+    seq: u64,
+    last_stamp_ns: u64,
+}
+
+fn wrap_pi(a: f64) -> f64 {
+    (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+}
+
+impl OdometryBuilder {
+    /// A command sent to the vehicle (panic stops included).
+    pub fn on_command(&mut self, cmd: &MotionCommand) {
+        self.command = *cmd;
+        self.start = None;
+    }
+
+    /// One encoder report; reports older than the last are refused.
+    pub fn on_encoders(&mut self, e: &EncodersRaw) -> Result<Odometry, String> {
+        if e.header.stamp_ns < self.last_stamp_ns {
+            return Err(format!(
+                "encoder report at {} ns is older than the last ({} ns)",
+                e.header.stamp_ns, self.last_stamp_ns
+            ));
+        }
+        if !(e.x_m.is_finite() && e.y_m.is_finite() && e.heading_rad.is_finite()) {
+            return Err("encoder report holds a non-finite number".into());
+        }
+        self.last_stamp_ns = e.header.stamp_ns;
+        let pose = Pose2 { x_m: e.x_m, y_m: e.y_m, heading_rad: e.heading_rad };
+        let accepted = self.command.command_id != 0 && e.command_id == self.command.command_id;
+        if accepted && self.start.is_none() {
+            self.start = Some(pose);
+        }
+        let (travelled_m, turned_rad) = match self.start {
+            Some(s) => {
+                ((pose.x_m - s.x_m).hypot(pose.y_m - s.y_m), wrap_pi(pose.heading_rad - s.heading_rad))
+            }
+            None => (0.0, 0.0),
+        };
+        self.seq += 1;
+        Ok(Odometry {
+            header: Header::new(self.seq, e.header.stamp_ns),
+            world_from_robot: pose,
+            travelled_m,
+            turned_rad,
+            command: self.command,
+            moving: e.moving,
+            command_accepted: u32::from(accepted),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use harvey_msgs::CommandKind;
+
+    fn enc(stamp_ns: u64, x_m: f64, heading_rad: f64, command_id: u32, moving: u32) -> EncodersRaw {
+        EncodersRaw { header: Header::new(1, stamp_ns), x_m, y_m: 0.0, heading_rad, moving, command_id }
+    }
+
+    #[test]
+    fn progress_counts_from_acceptance() {
+        let mut o = OdometryBuilder::default();
+        o.on_encoders(&enc(1, 0.5, 0.0, 0, 0)).expect("ok");
+        o.on_command(&MotionCommand {
+            kind: CommandKind::Move as u32,
+            distance_m: 2.0,
+            command_id: 3,
+            ..Default::default()
+        });
+        let before = o.on_encoders(&enc(2, 0.5, 0.0, 0, 0)).expect("ok");
+        assert_eq!((before.command_accepted, before.travelled_m), (0, 0.0));
+        o.on_encoders(&enc(3, 0.5, 0.0, 3, 1)).expect("ok");
+        let later = o.on_encoders(&enc(4, 1.7, 0.0, 3, 1)).expect("ok");
+        assert_eq!(later.command_accepted, 1);
+        assert!((later.travelled_m - 1.2).abs() < 1e-12);
+        assert_eq!(later.command.distance_m, 2.0);
+    }
+
+    #[test]
+    fn turns_wrap_and_bad_reports_are_refused() {
+        let mut o = OdometryBuilder::default();
+        o.on_command(&MotionCommand { kind: CommandKind::Turn as u32, command_id: 1, ..Default::default() });
+        o.on_encoders(&enc(10, 0.0, 6.2, 1, 1)).expect("ok");
+        let t = o.on_encoders(&enc(20, 0.0, 0.1, 1, 0)).expect("ok");
+        assert!((t.turned_rad - (0.1 + std::f64::consts::TAU - 6.2)).abs() < 1e-9, "{}", t.turned_rad);
+        assert!(o.on_encoders(&enc(5, 0.0, 0.0, 1, 0)).is_err(), "out of order");
+        assert!(o.on_encoders(&enc(30, f64::NAN, 0.0, 1, 0)).is_err(), "NaN");
+    }
+}

@@ -47,11 +47,7 @@ impl SimDrv {
         let mut rng = Rng::new(seed);
         let drift_sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
         let s = world.start;
-        let truth = Pose {
-            x: s.x_m,
-            y: s.y_m,
-            th: s.heading_deg.to_radians(),
-        };
+        let truth = Pose { x: s.x_m, y: s.y_m, th: s.heading_deg.to_radians() };
         Self {
             world,
             tick_ms,
@@ -90,16 +86,10 @@ impl SimDrv {
             Command::Move { id, hundredths_ft } => {
                 let ft = f64::from(hundredths_ft) / 100.0;
                 if ft.abs() > MAX_MOVE_FT {
-                    return Report::Nak {
-                        id,
-                        reason: NakReason::OutOfRange,
-                    };
+                    return Report::Nak { id, reason: NakReason::OutOfRange };
                 }
                 if self.motion.is_some() {
-                    return Report::Nak {
-                        id,
-                        reason: NakReason::Busy,
-                    };
+                    return Report::Nak { id, reason: NakReason::Busy };
                 }
                 let m = motion::plan_move(
                     &t,
@@ -115,16 +105,10 @@ impl SimDrv {
             Command::Turn { id, tenths_deg } => {
                 let deg = f64::from(tenths_deg) / 10.0;
                 if deg.abs() > MAX_TURN_DEG {
-                    return Report::Nak {
-                        id,
-                        reason: NakReason::OutOfRange,
-                    };
+                    return Report::Nak { id, reason: NakReason::OutOfRange };
                 }
                 if self.motion.is_some() {
-                    return Report::Nak {
-                        id,
-                        reason: NakReason::Busy,
-                    };
+                    return Report::Nak { id, reason: NakReason::Busy };
                 }
                 let rate = r.turn_rate_degps.to_radians();
                 (
@@ -139,34 +123,17 @@ impl SimDrv {
                     )),
                 )
             }
-            Command::Velocity {
-                id,
-                hundredths_ft_per_s,
-                tenths_deg_per_s,
-            } => {
+            Command::Velocity { id, hundredths_ft_per_s, tenths_deg_per_s } => {
                 let v = f64::from(hundredths_ft_per_s) / 100.0 * FT;
                 let w = (f64::from(tenths_deg_per_s) / 10.0).to_radians();
                 if v.abs() > r.speed_mps * 1.5 || w.abs() > r.turn_rate_degps.to_radians() * 1.5 {
-                    return Report::Nak {
-                        id,
-                        reason: NakReason::OutOfRange,
-                    };
+                    return Report::Nak { id, reason: NakReason::OutOfRange };
                 }
                 let drift = self.drift_sign
-                    * self
-                        .rng
-                        .normal(t.drift_deg_per_ft, t.drift_sd_deg_per_ft)
-                        .to_radians()
+                    * self.rng.normal(t.drift_deg_per_ft, t.drift_sd_deg_per_ft).to_radians()
                     / FT;
                 let idle = v == 0.0 && w == 0.0;
-                (
-                    id,
-                    (!idle).then_some(Motion::Velocity {
-                        v_mps: v,
-                        w_radps: w,
-                        drift_rad_per_m: drift,
-                    }),
-                )
+                (id, (!idle).then_some(Motion::Velocity { v_mps: v, w_radps: w, drift_rad_per_m: drift }))
             }
         };
         self.motion = motion;
@@ -200,17 +167,9 @@ impl SimDrv {
                 moving: self.motion.is_some(),
                 command_id: self.last_command,
             },
-            Report::Sonar {
-                time_ms: self.time_ms,
-                bank,
-                ranges_tenths_ft,
-            },
+            Report::Sonar { time_ms: self.time_ms, bank, ranges_tenths_ft },
         ];
-        TickOutput {
-            time_ms: self.time_ms,
-            truth: self.truth,
-            reports,
-        }
+        TickOutput { time_ms: self.time_ms, truth: self.truth, reports }
     }
 }
 
@@ -219,30 +178,18 @@ mod tests {
     use super::*;
 
     fn sim(seed: u64) -> SimDrv {
-        let w = harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway")
-            .expect("loads");
+        let w =
+            harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads");
         SimDrv::new(w, 50, seed)
     }
 
     #[test]
     fn a_move_runs_to_completion_and_reports_it() {
         let mut s = sim(3);
+        assert_eq!(s.handle(Command::Move { id: 1, hundredths_ft: 1000 }), Report::Ack { id: 1 });
         assert_eq!(
-            s.handle(Command::Move {
-                id: 1,
-                hundredths_ft: 1000
-            }),
-            Report::Ack { id: 1 }
-        );
-        assert_eq!(
-            s.handle(Command::Move {
-                id: 2,
-                hundredths_ft: 1000
-            }),
-            Report::Nak {
-                id: 2,
-                reason: NakReason::Busy
-            }
+            s.handle(Command::Move { id: 2, hundredths_ft: 1000 }),
+            Report::Nak { id: 2, reason: NakReason::Busy }
         );
         let mut last = None;
         for _ in 0..400 {
@@ -253,13 +200,7 @@ mod tests {
         }
         let out = last.expect("ticked");
         assert!(!s.is_moving());
-        let Report::Encoders {
-            x_hundredths_ft,
-            moving,
-            command_id,
-            ..
-        } = out.reports[0]
-        else {
+        let Report::Encoders { x_hundredths_ft, moving, command_id, .. } = out.reports[0] else {
             panic!("{out:?}")
         };
         assert_eq!((x_hundredths_ft, moving, command_id), (1000, false, 1));
@@ -271,24 +212,12 @@ mod tests {
     fn impossible_commands_are_refused() {
         let mut s = sim(3);
         assert_eq!(
-            s.handle(Command::Move {
-                id: 5,
-                hundredths_ft: 528_000
-            }),
-            Report::Nak {
-                id: 5,
-                reason: NakReason::OutOfRange
-            }
+            s.handle(Command::Move { id: 5, hundredths_ft: 528_000 }),
+            Report::Nak { id: 5, reason: NakReason::OutOfRange }
         );
         assert_eq!(
-            s.handle(Command::Turn {
-                id: 6,
-                tenths_deg: 7200
-            }),
-            Report::Nak {
-                id: 6,
-                reason: NakReason::OutOfRange
-            }
+            s.handle(Command::Turn { id: 6, tenths_deg: 7200 }),
+            Report::Nak { id: 6, reason: NakReason::OutOfRange }
         );
         assert!(!s.is_moving());
     }
@@ -297,10 +226,7 @@ mod tests {
     fn same_seed_same_run() {
         let run = |seed| {
             let mut s = sim(seed);
-            s.handle(Command::Turn {
-                id: 1,
-                tenths_deg: 450,
-            });
+            s.handle(Command::Turn { id: 1, tenths_deg: 450 });
             (0..100).map(|_| s.tick()).collect::<Vec<_>>()
         };
         assert_eq!(run(9), run(9));

@@ -36,10 +36,7 @@ struct Args {
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
-    anyhow::ensure!(
-        args.tick_ms > 0 && args.speedup > 0.0,
-        "--tick-ms and --speedup must be positive"
-    );
+    anyhow::ensure!(args.tick_ms > 0 && args.speedup > 0.0, "--tick-ms and --speedup must be positive");
     let world = harvey_world::World::load(&args.world)?;
     let mut sim = SimDrv::new(world, args.tick_ms, args.seed);
 
@@ -81,26 +78,16 @@ fn main() -> anyhow::Result<()> {
             Err(e) => tracing::warn!("bad frame from the host: {e}"),
         });
         for r in replies {
-            dropped_frames += u64::from(!write_frame(
-                &mut line,
-                encode(&Line::Report(r)).as_bytes(),
-            )?);
+            dropped_frames += u64::from(!write_frame(&mut line, encode(&Line::Report(r)).as_bytes())?);
         }
         if Instant::now() >= next_tick {
             next_tick += period;
             let out = sim.tick();
             for r in &out.reports {
-                dropped_frames += u64::from(!write_frame(
-                    &mut line,
-                    encode(&Line::Report(*r)).as_bytes(),
-                )?);
+                dropped_frames += u64::from(!write_frame(&mut line, encode(&Line::Report(*r)).as_bytes())?);
             }
             let stamp_ns = out.time_ms * 1_000_000;
-            let pose = Pose2 {
-                x_m: out.truth.x,
-                y_m: out.truth.y,
-                heading_rad: out.truth.th,
-            };
+            let pose = Pose2 { x_m: out.truth.x, y_m: out.truth.y, heading_rad: out.truth.th };
             truth_pub.send(&TruePose {
                 header: Header::new(stamp_ns / (args.tick_ms * 1_000_000), stamp_ns),
                 world_from_robot: pose,

@@ -21,11 +21,7 @@ impl Pose {
     /// `dth` over the way (an arc; a straight line when `dth` is 0).
     pub fn arc(&self, s: f64, dth: f64) -> Pose {
         if dth.abs() < 1e-9 {
-            return Pose {
-                x: self.x + s * self.th.cos(),
-                y: self.y + s * self.th.sin(),
-                th: self.th,
-            };
+            return Pose { x: self.x + s * self.th.cos(), y: self.y + s * self.th.sin(), th: self.th };
         }
         let r = s / dth;
         Pose {
@@ -37,11 +33,7 @@ impl Pose {
 
     /// Shifted sideways by `d` metres (positive: to the left of the heading).
     pub fn sideways(&self, d: f64) -> Pose {
-        Pose {
-            x: self.x - d * self.th.sin(),
-            y: self.y + d * self.th.cos(),
-            th: self.th,
-        }
+        Pose { x: self.x - d * self.th.sin(), y: self.y + d * self.th.cos(), th: self.th }
     }
 }
 
@@ -113,10 +105,7 @@ pub fn plan_turn(
     let deg = commanded_rad.abs().to_degrees();
     let loss = (t.rotational_loss_deg_per_deg + rng.normal(0.0, t.rotational_sd_deg_per_deg)) * deg;
     let true_deg = (deg - loss).clamp(0.0, deg);
-    let skitter_ft = rng
-        .normal(t.skitter_ft_per_deg, t.skitter_sd_ft_per_deg)
-        .max(0.0)
-        * deg;
+    let skitter_ft = rng.normal(t.skitter_ft_per_deg, t.skitter_sd_ft_per_deg).max(0.0) * deg;
     Motion::Turn {
         truth0,
         enc0,
@@ -130,78 +119,26 @@ pub fn plan_turn(
 }
 
 /// Advances a motion by `dt_s`; returns the new (truth, encoder) poses and whether it finished.
-pub fn advance(
-    m: &mut Motion,
-    t: &Terrain,
-    truth: Pose,
-    enc: Pose,
-    dt_s: f64,
-) -> (Pose, Pose, bool) {
+pub fn advance(m: &mut Motion, t: &Terrain, truth: Pose, enc: Pose, dt_s: f64) -> (Pose, Pose, bool) {
     match m {
-        Motion::Move {
-            truth0,
-            enc0,
-            true_m,
-            true_dth,
-            commanded_m,
-            done,
-            duration_s,
-        } => {
-            *done = if *duration_s > 0.0 {
-                (*done + dt_s / *duration_s).min(1.0)
-            } else {
-                1.0
-            };
+        Motion::Move { truth0, enc0, true_m, true_dth, commanded_m, done, duration_s } => {
+            *done = if *duration_s > 0.0 { (*done + dt_s / *duration_s).min(1.0) } else { 1.0 };
             let f = *done;
-            (
-                truth0.arc(f * *true_m, f * *true_dth),
-                enc0.arc(f * *commanded_m, 0.0),
-                f >= 1.0,
-            )
+            (truth0.arc(f * *true_m, f * *true_dth), enc0.arc(f * *commanded_m, 0.0), f >= 1.0)
         }
-        Motion::Turn {
-            truth0,
-            enc0,
-            true_rad,
-            skitter_m,
-            commanded_rad,
-            done,
-            duration_s,
-        } => {
-            *done = if *duration_s > 0.0 {
-                (*done + dt_s / *duration_s).min(1.0)
-            } else {
-                1.0
-            };
+        Motion::Turn { truth0, enc0, true_rad, skitter_m, commanded_rad, done, duration_s } => {
+            *done = if *duration_s > 0.0 { (*done + dt_s / *duration_s).min(1.0) } else { 1.0 };
             let f = *done;
             let shifted = truth0.sideways(f * *skitter_m);
-            let truth = Pose {
-                th: truth0.th + f * *true_rad,
-                ..shifted
-            };
-            (
-                truth,
-                Pose {
-                    th: enc0.th + f * *commanded_rad,
-                    ..*enc0
-                },
-                f >= 1.0,
-            )
+            let truth = Pose { th: truth0.th + f * *true_rad, ..shifted };
+            (truth, Pose { th: enc0.th + f * *commanded_rad, ..*enc0 }, f >= 1.0)
         }
-        Motion::Velocity {
-            v_mps,
-            w_radps,
-            drift_rad_per_m,
-        } => {
+        Motion::Velocity { v_mps, w_radps, drift_rad_per_m } => {
             let s_true = *v_mps * (1.0 - t.translational_loss_ft_per_ft) * dt_s;
-            let dth_true = *w_radps * (1.0 - t.rotational_loss_deg_per_deg) * dt_s
-                + *drift_rad_per_m * s_true.abs();
+            let dth_true =
+                *w_radps * (1.0 - t.rotational_loss_deg_per_deg) * dt_s + *drift_rad_per_m * s_true.abs();
             let idle = *v_mps == 0.0 && *w_radps == 0.0;
-            (
-                truth.arc(s_true, dth_true),
-                enc.arc(*v_mps * dt_s, *w_radps * dt_s),
-                idle,
-            )
+            (truth.arc(s_true, dth_true), enc.arc(*v_mps * dt_s, *w_radps * dt_s), idle)
         }
     }
 }
@@ -230,22 +167,10 @@ mod tests {
         let n = 2000;
         let mut travelled_ft = Vec::new();
         for _ in 0..n {
-            let mut m = plan_move(
-                &tile(),
-                &mut rng,
-                1.0,
-                Pose::default(),
-                Pose::default(),
-                20.0 * FT,
-                0.3,
-            );
-            let (truth, enc, finished) =
-                advance(&mut m, &tile(), Pose::default(), Pose::default(), 1e6);
+            let mut m = plan_move(&tile(), &mut rng, 1.0, Pose::default(), Pose::default(), 20.0 * FT, 0.3);
+            let (truth, enc, finished) = advance(&mut m, &tile(), Pose::default(), Pose::default(), 1e6);
             assert!(finished);
-            assert!(
-                (enc.x - 20.0 * FT).abs() < 1e-9,
-                "encoders report the commanded move"
-            );
+            assert!((enc.x - 20.0 * FT).abs() < 1e-9, "encoders report the commanded move");
             let d = truth.x.hypot(truth.y) / FT;
             assert!(d <= 20.0 + 1e-9, "never further than commanded: {d}");
             travelled_ft.push(d);
@@ -258,11 +183,7 @@ mod tests {
 
     #[test]
     fn arcs_and_turns_compose() {
-        let p = Pose {
-            x: 1.0,
-            y: 2.0,
-            th: 0.5,
-        };
+        let p = Pose { x: 1.0, y: 2.0, th: 0.5 };
         let q = p.arc(3.0, 0.0);
         assert!((q.x - (1.0 + 3.0 * 0.5f64.cos())).abs() < 1e-12);
         let r = p.arc(1e-3, 1e-12);

@@ -19,10 +19,7 @@ pub fn bearing_rad(i: usize) -> f64 {
 pub fn read_sensor(world: &World, truth: Pose, i: usize) -> u16 {
     let r = &world.robot;
     let axis = truth.th + bearing_rad(i);
-    let origin = [
-        truth.x + r.sonar_ring_radius_m * axis.cos(),
-        truth.y + r.sonar_ring_radius_m * axis.sin(),
-    ];
+    let origin = [truth.x + r.sonar_ring_radius_m * axis.cos(), truth.y + r.sonar_ring_radius_m * axis.sin()];
     let half = (r.sonar_beam_width_deg / 2.0).to_radians();
     let limit = r.sonar_specular_limit_deg.to_radians();
     let max_m = r.sonar_max_range_ft * FT;
@@ -35,9 +32,7 @@ pub fn read_sensor(world: &World, truth: Pose, i: usize) -> u16 {
         .map(|h| h.distance_m)
         .fold(f64::INFINITY, f64::min);
     if nearest.is_finite() {
-        ((nearest / FT) * 10.0)
-            .round()
-            .min(f64::from(SONAR_NO_ECHO - 1)) as u16
+        ((nearest / FT) * 10.0).round().min(f64::from(SONAR_NO_ECHO - 1)) as u16
     } else {
         SONAR_NO_ECHO
     }
@@ -53,19 +48,14 @@ mod tests {
     use super::*;
 
     fn hallway() -> World {
-        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway")
-            .expect("loads")
+        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
     }
 
     #[test]
     fn a_wall_abeam_reads_its_distance_to_a_tenth_of_a_foot() {
         let w = hallway();
         // Robot on the centre line facing +x: sensor 6 (90 degrees) faces the left wall 1 m away.
-        let truth = Pose {
-            x: 2.0,
-            y: 0.0,
-            th: 0.0,
-        };
+        let truth = Pose { x: 2.0, y: 0.0, th: 0.0 };
         let expected = (1.0 - w.robot.sonar_ring_radius_m) / FT * 10.0;
         let got = f64::from(read_sensor(&w, truth, 6));
         assert!((got - expected).abs() <= 1.0, "{got} vs {expected}");
@@ -77,11 +67,7 @@ mod tests {
         // Facing along the corridor from its far end region, sensor 0 looks 17 m down the hall
         // at the end wall head-on, but sensor 1 (15 degrees) with the robot hugging the wall sees
         // the side wall only at grazing incidence.
-        let truth = Pose {
-            x: 0.0,
-            y: 0.75,
-            th: 0.0,
-        };
+        let truth = Pose { x: 0.0, y: 0.75, th: 0.0 };
         assert_eq!(read_sensor(&w, truth, 1), SONAR_NO_ECHO);
     }
 }

@@ -1,1 +1,108 @@
-//! Vision workers: perceptual algorithms on camera frames read in place.
+//! Vision workers' logic. This first worker finds vertical edges (door frames, wall corners) in a
+//! horizontal band of the frame, read in place; the papers' algorithms join it in their issue.
+
+use harvey_msgs::{Detections, Feature, FrameHeader, Header, MAX_FEATURES};
+
+/// Algorithm ids carried in [`Detections::algorithm`].
+pub const ALGO_VERTICAL_EDGES: u32 = 1;
+
+/// Finds vertical edges in a band of rows; keeps its scratch between frames.
+#[derive(Debug)]
+pub struct VerticalEdges {
+    /// Half-height of the band around the image centre row.
+    pub band_half_rows: u32,
+    /// Mean absolute horizontal difference (grey levels) an edge must exceed.
+    pub threshold: f32,
+    profile: Vec<f32>,
+    found: Vec<Feature>,
+    seq: u64,
+}
+
+impl VerticalEdges {
+    pub fn new(band_half_rows: u32, threshold: f32) -> Self {
+        Self { band_half_rows, threshold, profile: Vec::new(), found: Vec::new(), seq: 0 }
+    }
+
+    /// Runs on one frame (mono8 or rgb8, first channel used).
+    pub fn run(&mut self, h: &FrameHeader, pixels: &[u8]) -> Result<Detections, String> {
+        let bpp = h
+            .encoding()
+            .ok_or_else(|| format!("frame {}: unknown encoding {}", h.seq, h.encoding))?
+            .bytes_per_pixel() as usize;
+        let (w, ht, stride) = (h.width_px as usize, h.height_px as usize, h.stride_bytes as usize);
+        if w < 3 || ht == 0 || stride < w * bpp || pixels.len() < stride * ht {
+            return Err(format!(
+                "frame {}: {w}x{ht} stride {stride} does not fit {} bytes",
+                h.seq,
+                pixels.len()
+            ));
+        }
+        let mid = ht / 2;
+        let half = (self.band_half_rows as usize).min(mid);
+        let rows = (mid - half)..(mid + half).max(mid + 1).min(ht);
+        self.profile.clear();
+        self.profile.resize(w - 1, 0.0);
+        for v in rows.clone() {
+            let row = &pixels[v * stride..v * stride + w * bpp];
+            for (u, acc) in self.profile.iter_mut().enumerate() {
+                *acc += f32::from(row[u * bpp].abs_diff(row[(u + 1) * bpp]));
+            }
+        }
+        let n_rows = rows.len() as f32;
+        let mut features = [Feature::default(); MAX_FEATURES];
+        let profile = &self.profile;
+        self.found.clear();
+        self.found.extend((0..w - 1).filter_map(|u| {
+            let s = profile[u] / n_rows;
+            let left = if u > 0 { profile[u - 1] / n_rows } else { 0.0 };
+            let right = profile.get(u + 1).map_or(0.0, |r| r / n_rows);
+            (s > self.threshold && s >= left && s > right).then_some(Feature {
+                x_px: u as f32 + 1.0,
+                y_px: mid as f32,
+                score: s,
+                kind: ALGO_VERTICAL_EDGES,
+            })
+        }));
+        let found = &mut self.found;
+        found.sort_by(|a, b| b.score.total_cmp(&a.score).then(a.x_px.total_cmp(&b.x_px)));
+        found.truncate(MAX_FEATURES);
+        features[..found.len()].copy_from_slice(found);
+        self.seq += 1;
+        Ok(Detections {
+            header: Header::new(self.seq, h.stamp_ns),
+            frame_seq: h.seq,
+            algorithm: ALGO_VERTICAL_EDGES,
+            count: found.len() as u32,
+            confidence: (found.len() as f32 / 4.0).min(1.0),
+            _pad: 0,
+            features,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use harvey_msgs::Encoding;
+
+    #[test]
+    fn finds_a_step_edge_where_it_is() {
+        let (w, h) = (64u32, 48u32);
+        let header = FrameHeader::new(5, 77, w, h, Encoding::Mono8);
+        let img: Vec<u8> = (0..w * h).map(|i| if i % w < 40 { 50 } else { 200 }).collect();
+        let mut e = VerticalEdges::new(8, 20.0);
+        let d = e.run(&header, &img).expect("runs");
+        assert_eq!((d.count, d.frame_seq, d.header.stamp_ns), (1, 5, 77));
+        assert_eq!(d.features[0].x_px, 40.0);
+        assert!((d.features[0].score - 150.0).abs() < 1e-3);
+    }
+
+    #[test]
+    fn malformed_frames_are_errors_not_crashes() {
+        let mut e = VerticalEdges::new(8, 20.0);
+        let header = FrameHeader::new(1, 0, 64, 48, Encoding::Mono8);
+        assert!(e.run(&header, &[0u8; 100]).is_err());
+        let bad = FrameHeader { encoding: 99, ..header };
+        assert!(e.run(&bad, &[0u8; 64 * 48]).is_err());
+    }
+}
