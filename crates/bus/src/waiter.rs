@@ -98,7 +98,7 @@ impl Waiter {
         Ok(Self { waitset })
     }
 
-    pub fn attach<'w, 'a>(&'w self, source: &'a impl Waitable) -> Result<Attachment<'w, 'a>> {
+    pub fn attach<'w, 'a>(&'w self, source: &'a (impl Waitable + ?Sized)) -> Result<Attachment<'w, 'a>> {
         let guard = self
             .waitset
             .attach_notification(source.multiplexed())

@@ -1,1 +1,11 @@
-//! placeholder
+//! ROS 2 CDR encoding (little-endian, `00 01 00 00` encapsulation) and `ros2msg` schema texts for
+//! Harvey's messages, so that ROS 2 tools, Foxglove and the Python `mcap-ros2-support` decoder
+//! read Harvey's recordings without Harvey's code. Decoding serves replay and `harvey info`.
+
+mod codec;
+mod schema;
+mod types;
+
+pub use codec::{Cdr, CdrError, CdrReader, CdrWriter, decode, encode};
+pub use schema::{Def, full_text};
+pub use types::{Ros2Msg, encode_image, image_def};

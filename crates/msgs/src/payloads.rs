@@ -127,7 +127,7 @@ pub struct MotionCommand {
     pub angular_radps: f64,
     /// Caller-chosen id, echoed in [`EncodersRaw::command_id`] once accepted.
     pub command_id: u32,
-    pub _pad: u32,
+    pub reserved: u32,
 }
 message!(MotionCommand);
 
@@ -176,7 +176,7 @@ pub struct Detections {
     pub algorithm: u32,
     pub count: u32,
     pub confidence: f32,
-    pub _pad: u32,
+    pub reserved: u32,
     pub features: [Feature; MAX_FEATURES],
 }
 message!(Detections);
@@ -190,7 +190,7 @@ pub struct UncertaintyMap {
     pub header: Header,
     pub centre: Pose2,
     pub vertex_count: u32,
-    pub _pad: u32,
+    pub reserved: u32,
     pub vertices_m: [[f64; 2]; MAX_POLYGON_VERTICES],
     pub heading_cw_rad: f64,
     pub heading_ccw_rad: f64,
@@ -229,7 +229,7 @@ pub struct MissionStatus {
     /// Index of the step under way (== `step_count` when done).
     pub step: u32,
     pub step_count: u32,
-    pub _pad: u32,
+    pub reserved: u32,
     pub estimated: Pose2,
     pub goal: Pose2,
     /// Sonar rings, frames' detections and maps seen so far: proof the data flowed.

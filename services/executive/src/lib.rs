@@ -144,7 +144,7 @@ impl Executive {
             state: self.state() as u32,
             step: step as u32,
             step_count: self.mission.steps.len() as u32,
-            _pad: 0,
+            reserved: 0,
             estimated: self.estimated,
             goal: self.goal,
             sonar_rings_seen: self.sonar_rings_seen,

@@ -58,7 +58,7 @@ impl Ums {
             header: Header::new(self.seq, o.header.stamp_ns),
             centre: p,
             vertex_count: 4,
-            _pad: 0,
+            reserved: 0,
             vertices_m,
             heading_cw_rad: p.heading_rad - wedge_rad,
             heading_ccw_rad: p.heading_rad + wedge_rad,

@@ -74,7 +74,7 @@ impl VerticalEdges {
             algorithm: ALGO_VERTICAL_EDGES,
             count: found.len() as u32,
             confidence: (found.len() as f32 / 4.0).min(1.0),
-            _pad: 0,
+            reserved: 0,
             features,
         })
     }

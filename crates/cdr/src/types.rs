@@ -1,0 +1,225 @@
+//! Harvey's messages in CDR: their `ros2msg` definitions and field-by-field codecs.
+//! A `Header` is written as a `std_msgs/Header` followed by `uint64 seq`.
+
+use harvey_msgs::{
+    Detections, EncodersRaw, Feature, FrameHeader, Header, MissionStatus, MotionCommand, Odometry, Pose2,
+    SonarRaw, SonarRing, TruePose, UncertaintyMap,
+};
+
+use crate::codec::{Cdr, CdrError, CdrReader, CdrWriter};
+use crate::schema::Def;
+
+/// A message type with a ROS 2 definition.
+pub trait Ros2Msg: Cdr {
+    const DEF: &'static Def;
+}
+
+static TIME: Def = Def { name: "builtin_interfaces/Time", text: "int32 sec\nuint32 nanosec\n", deps: &[] };
+static STD_HEADER: Def =
+    Def { name: "std_msgs/Header", text: "builtin_interfaces/Time stamp\nstring frame_id\n", deps: &[&TIME] };
+static MOTION_COMMAND: Def = Def {
+    name: "harvey_msgs/MotionCommand",
+    text: "std_msgs/Header header\nuint64 seq\n\
+           uint32 kind # 0 stop, 1 move, 2 turn, 3 velocity\nuint32 urgent\n\
+           float64 distance_m\nfloat64 angle_rad\nfloat64 linear_mps\nfloat64 angular_radps\n\
+           uint32 command_id\nuint32 reserved\n",
+    deps: &[&STD_HEADER],
+};
+static IMAGE: Def = Def {
+    name: "sensor_msgs/Image",
+    text: "std_msgs/Header header\nuint32 height\nuint32 width\nstring encoding\nuint8 is_bigendian\nuint32 step\nuint8[] data\n",
+    deps: &[&STD_HEADER],
+};
+
+/// The definition of `sensor_msgs/msg/Image`, the camera topic's type.
+pub fn image_def() -> &'static Def {
+    &IMAGE
+}
+
+fn write_std_header(stamp_ns: u64, frame_id: &str, w: &mut CdrWriter) {
+    w.prim((stamp_ns / 1_000_000_000) as i32);
+    w.prim((stamp_ns % 1_000_000_000) as u32);
+    w.string(frame_id);
+}
+
+impl Cdr for Header {
+    fn write(&self, w: &mut CdrWriter) {
+        write_std_header(self.stamp_ns, "", w);
+        w.prim(self.seq);
+    }
+    fn read(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        let sec = r.prim::<i32>()?;
+        let nanosec = r.prim::<u32>()?;
+        let _frame_id = r.string()?;
+        let seq = r.prim::<u64>()?;
+        let stamp_ns = u64::try_from(sec).unwrap_or(0) * 1_000_000_000 + u64::from(nanosec);
+        Ok(Header { seq, stamp_ns })
+    }
+}
+
+/// Encodes a camera frame as `sensor_msgs/msg/Image` into `buf` (reused).
+pub fn encode_image(h: &FrameHeader, pixels: &[u8], buf: Vec<u8>) -> Vec<u8> {
+    let mut w = CdrWriter::start(buf);
+    write_std_header(h.stamp_ns, "camera", &mut w);
+    w.prim(h.height_px);
+    w.prim(h.width_px);
+    w.string(h.encoding().map_or("", |e| e.ros_name()));
+    w.prim(0u8);
+    w.prim(h.stride_bytes);
+    w.byte_seq(pixels);
+    w.finish()
+}
+
+macro_rules! ros2_struct {
+    ($t:ty, $def:ident = ($name:literal, $text:expr, [$($dep:expr),*]) { $($f:ident),* $(,)? }) => {
+        static $def: Def = Def { name: $name, text: $text, deps: &[$($dep),*] };
+        impl Cdr for $t {
+            fn write(&self, w: &mut CdrWriter) {
+                $( self.$f.write(w); )*
+            }
+            fn read(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+                Ok(Self { $( $f: Cdr::read(r)?, )* })
+            }
+        }
+        impl Ros2Msg for $t {
+            const DEF: &'static Def = &$def;
+        }
+    };
+}
+
+/// A Harvey message's text begins with its header: `std_msgs/Header` plus the sequence number.
+macro_rules! with_header {
+    ($s:literal) => {
+        concat!("std_msgs/Header header\nuint64 seq\n", $s)
+    };
+}
+
+ros2_struct!(Pose2, POSE2 = ("harvey_msgs/Pose2", "float64 x_m\nfloat64 y_m\nfloat64 heading_rad\n", []) { x_m, y_m, heading_rad });
+ros2_struct!(Feature, FEATURE = ("harvey_msgs/Feature", "float32 x_px\nfloat32 y_px\nfloat32 score\nuint32 kind\n", []) { x_px, y_px, score, kind });
+ros2_struct!(TruePose, TRUE_POSE = ("harvey_msgs/TruePose", with_header!("harvey_msgs/Pose2 world_from_robot\n"), [&STD_HEADER, &POSE2]) { header, world_from_robot });
+ros2_struct!(SonarRaw, SONAR_RAW = ("harvey_msgs/SonarRaw", with_header!("uint32 bank\nuint32 echo_mask\nfloat32[8] range_m\n"), [&STD_HEADER]) { header, bank, echo_mask, range_m });
+ros2_struct!(SonarRing, SONAR_RING = ("harvey_msgs/SonarRing", with_header!("float32[24] range_m\nfloat32[24] bearing_rad\nuint64[24] reading_stamp_ns\nuint32 valid_mask\nuint32 panic_stop\n"), [&STD_HEADER]) { header, range_m, bearing_rad, reading_stamp_ns, valid_mask, panic_stop });
+ros2_struct!(EncodersRaw, ENCODERS_RAW = ("harvey_msgs/EncodersRaw", with_header!("float64 x_m\nfloat64 y_m\nfloat64 heading_rad\nuint32 moving\nuint32 command_id\n"), [&STD_HEADER]) { header, x_m, y_m, heading_rad, moving, command_id });
+ros2_struct!(Odometry, ODOMETRY = ("harvey_msgs/Odometry", with_header!("harvey_msgs/Pose2 world_from_robot\nfloat64 travelled_m\nfloat64 turned_rad\nharvey_msgs/MotionCommand command\nuint32 moving\nuint32 command_accepted\n"), [&STD_HEADER, &POSE2, &MOTION_COMMAND]) { header, world_from_robot, travelled_m, turned_rad, command, moving, command_accepted });
+ros2_struct!(Detections, DETECTIONS = ("harvey_msgs/Detections", with_header!("uint64 frame_seq\nuint32 algorithm\nuint32 count\nfloat32 confidence\nuint32 reserved\nharvey_msgs/Feature[32] features\n"), [&STD_HEADER, &FEATURE]) { header, frame_seq, algorithm, count, confidence, reserved, features });
+ros2_struct!(UncertaintyMap, UNCERTAINTY_MAP = ("harvey_msgs/UncertaintyMap", with_header!("harvey_msgs/Pose2 centre\nuint32 vertex_count\nuint32 reserved\nfloat64[64] vertices_m # x0 y0 x1 y1 ...\nfloat64 heading_cw_rad\nfloat64 heading_ccw_rad\nfloat64 area_m2\n"), [&STD_HEADER, &POSE2]) { header, centre, vertex_count, reserved, vertices_m, heading_cw_rad, heading_ccw_rad, area_m2 });
+ros2_struct!(MissionStatus, MISSION_STATUS = ("harvey_msgs/MissionStatus", with_header!("uint32 state # 0 running, 1 succeeded, 2 failed\nuint32 step\nuint32 step_count\nuint32 reserved\nharvey_msgs/Pose2 estimated\nharvey_msgs/Pose2 goal\nuint64 sonar_rings_seen\nuint64 detections_seen\nuint64 maps_seen\n"), [&STD_HEADER, &POSE2]) { header, state, step, step_count, reserved, estimated, goal, sonar_rings_seen, detections_seen, maps_seen });
+
+impl Cdr for MotionCommand {
+    fn write(&self, w: &mut CdrWriter) {
+        self.header.write(w);
+        [self.kind, self.urgent].write(w);
+        [self.distance_m, self.angle_rad, self.linear_mps, self.angular_radps].write(w);
+        [self.command_id, self.reserved].write(w);
+    }
+    fn read(r: &mut CdrReader<'_>) -> Result<Self, CdrError> {
+        let header = Header::read(r)?;
+        let [kind, urgent] = <[u32; 2]>::read(r)?;
+        let [distance_m, angle_rad, linear_mps, angular_radps] = <[f64; 4]>::read(r)?;
+        let [command_id, reserved] = <[u32; 2]>::read(r)?;
+        Ok(Self {
+            header,
+            kind,
+            urgent,
+            distance_m,
+            angle_rad,
+            linear_mps,
+            angular_radps,
+            command_id,
+            reserved,
+        })
+    }
+}
+
+impl Ros2Msg for MotionCommand {
+    const DEF: &'static Def = &MOTION_COMMAND;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{decode, encode, full_text};
+    use harvey_msgs::{Encoding, MAX_FEATURES};
+
+    fn round_trip<T: Ros2Msg + PartialEq + core::fmt::Debug>(v: T) {
+        let bytes = encode(&v, Vec::new());
+        assert_eq!(&bytes[..4], &[0, 1, 0, 0]);
+        assert_eq!(decode::<T>(&bytes).expect("decodes"), v);
+        assert!(decode::<T>(&bytes[..bytes.len() - 1]).is_err(), "truncated must fail");
+    }
+
+    #[test]
+    fn every_message_round_trips() {
+        let h = Header::new(42, 3_000_000_123);
+        let pose = Pose2 { x_m: 1.5, y_m: -2.0, heading_rad: 0.25 };
+        let cmd = MotionCommand { header: h, kind: 1, distance_m: 2.0, command_id: 9, ..Default::default() };
+        round_trip(TruePose { header: h, world_from_robot: pose });
+        round_trip(SonarRaw { header: h, bank: 2, echo_mask: 0x7f, range_m: [1.25; 8] });
+        round_trip(SonarRing { header: h, range_m: [2.0; 24], valid_mask: 5, ..Default::default() });
+        round_trip(EncodersRaw { header: h, x_m: 1.0, y_m: 2.0, heading_rad: 3.0, moving: 1, command_id: 4 });
+        round_trip(cmd);
+        round_trip(Odometry {
+            header: h,
+            world_from_robot: pose,
+            travelled_m: 1.0,
+            command: cmd,
+            moving: 1,
+            ..Default::default()
+        });
+        let mut features = [Feature::default(); MAX_FEATURES];
+        features[3] = Feature { x_px: 10.5, y_px: 4.0, score: 0.9, kind: 1 };
+        round_trip(Detections { header: h, frame_seq: 7, count: 4, features, ..Default::default() });
+        round_trip(UncertaintyMap {
+            header: h,
+            centre: pose,
+            vertex_count: 4,
+            area_m2: 0.5,
+            ..Default::default()
+        });
+        round_trip(MissionStatus { header: h, state: 1, goal: pose, maps_seen: 3, ..Default::default() });
+    }
+
+    #[test]
+    fn header_is_a_std_header_then_seq() {
+        let bytes = encode(&Header::new(7, 2_500_000_000), Vec::new());
+        // sec=2, nanosec=5e8, frame_id "" (len 1 + NUL), pad to 8, seq.
+        let expected: Vec<u8> = [
+            &[0, 1, 0, 0][..],
+            &2i32.to_le_bytes(),
+            &500_000_000u32.to_le_bytes(),
+            &1u32.to_le_bytes(),
+            &[0, 0, 0, 0],
+            &7u64.to_le_bytes(),
+        ]
+        .concat();
+        assert_eq!(bytes, expected);
+    }
+
+    #[test]
+    fn schemas_append_dependencies_once_in_sorted_order() {
+        let text = full_text(Odometry::DEF);
+        let sections: Vec<&str> = text.lines().filter_map(|l| l.strip_prefix("MSG: ")).collect();
+        assert_eq!(
+            sections,
+            ["harvey_msgs/MotionCommand", "std_msgs/Header", "builtin_interfaces/Time", "harvey_msgs/Pose2"]
+        );
+        assert!(text.contains("\n\n================================================================================\nMSG: std_msgs/Header\n"));
+        assert_eq!(Odometry::DEF.schema_name(), "harvey_msgs/msg/Odometry");
+    }
+
+    #[test]
+    fn images_follow_sensor_msgs_layout() {
+        let h = FrameHeader::new(1, 1_000_000_005, 2, 2, Encoding::Mono8);
+        let bytes = encode_image(&h, &[1, 2, 3, 4], Vec::new());
+        let mut r = CdrReader::new(&bytes).expect("header");
+        assert_eq!((r.prim::<i32>().expect("sec"), r.prim::<u32>().expect("ns")), (1, 5));
+        assert_eq!(r.string().expect("frame_id"), "camera");
+        assert_eq!((r.prim::<u32>().expect("h"), r.prim::<u32>().expect("w")), (2, 2));
+        assert_eq!(r.string().expect("encoding"), "mono8");
+        assert_eq!(r.prim::<u8>().expect("bigendian"), 0);
+        assert_eq!(r.prim::<u32>().expect("step"), 2);
+        assert_eq!(r.byte_seq().expect("data"), &[1, 2, 3, 4]);
+        assert_eq!(r.remaining(), 0);
+        assert_eq!(image_def().schema_name(), "sensor_msgs/msg/Image");
+    }
+}
