@@ -1,2 +1,109 @@
-//! harvey CLI
-fn main() {}
+//! harvey: the command line — run the default mission, launch a launch file under the
+//! supervisor, and inspect recordings.
+
+mod launch;
+mod summary;
+
+use std::path::{Path, PathBuf};
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser)]
+#[command(name = "harvey", version, about = "Harvey robotics stack: missions, supervisor and recordings")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Cmd>,
+}
+
+#[derive(Subcommand)]
+enum Cmd {
+    /// Run a mission (default: missions/default.toml), record it and print its summary.
+    Run {
+        mission: Option<PathBuf>,
+        #[command(flatten)]
+        opts: LaunchArgs,
+    },
+    /// Run a launch file under the supervisor.
+    Launch {
+        file: PathBuf,
+        #[command(flatten)]
+        opts: LaunchArgs,
+    },
+    /// Topics, counts, rates, duration and gaps of a recording.
+    Info { recording: PathBuf },
+}
+
+#[derive(clap::Args)]
+struct LaunchArgs {
+    /// Output folder (default: recordings/<launch name>).
+    #[arg(long)]
+    run_dir: Option<PathBuf>,
+    /// Bus domain prefix; runs with different prefixes never see each other.
+    #[arg(long, default_value = harvey_bus::DEFAULT_PREFIX)]
+    prefix: String,
+}
+
+const DEFAULT_MISSION: &str = "missions/default.toml";
+
+fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(launch::Outcome, PathBuf)> {
+    let lf = launch::LaunchFile::load(file)?;
+    let run_dir = args.run_dir.clone().unwrap_or_else(|| Path::new("recordings").join(&lf.settings.name));
+    let opts = launch::Options { prefix: args.prefix.clone(), run_dir: run_dir.clone() };
+    tracing::info!(launch = %lf.settings.name, run_dir = %run_dir.display(), prefix = %opts.prefix, "launching {} services", lf.services.len());
+    Ok((launch::run(&lf, &opts)?, run_dir))
+}
+
+fn main() {
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env().unwrap_or_else(|_| "info".into());
+    let ansi = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    tracing_subscriber::fmt()
+        .with_env_filter(filter)
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .with_ansi(ansi)
+        .init();
+    let cli = Cli::parse();
+    let code = match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("harvey: error: {e:#}");
+            2
+        }
+    };
+    std::process::exit(code);
+}
+
+fn run(cli: Cli) -> anyhow::Result<i32> {
+    let cmd = cli.command.unwrap_or(Cmd::Run {
+        mission: None,
+        opts: LaunchArgs { run_dir: None, prefix: harvey_bus::DEFAULT_PREFIX.into() },
+    });
+    match cmd {
+        Cmd::Run { mission, opts } => {
+            let file = mission.unwrap_or_else(|| PathBuf::from(DEFAULT_MISSION));
+            let (outcome, run_dir) = launch_file(&file, &opts)?;
+            let mcap = run_dir.join("run.mcap");
+            println!("launch: {outcome:?}");
+            if mcap.is_file() {
+                let stats = summary::RunStats::read(&mcap)?;
+                print!("{}", stats.mission_summary());
+                println!(
+                    "recording: {} ({} messages on {} topics)",
+                    mcap.display(),
+                    stats.message_count(),
+                    stats.topics.len()
+                );
+            }
+            Ok(outcome.exit_code())
+        }
+        Cmd::Launch { file, opts } => {
+            let (outcome, _) = launch_file(&file, &opts)?;
+            println!("launch: {outcome:?}");
+            Ok(outcome.exit_code())
+        }
+        Cmd::Info { recording } => {
+            print!("{}", summary::RunStats::read(&recording)?.info_table());
+            Ok(0)
+        }
+    }
+}

@@ -1,0 +1,233 @@
+//! Launch files: which services to start, in what order, with which arguments and restart
+//! policy. Errors name the file, line and key.
+
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+use toml::Spanned;
+
+/// When a service that exited is started again.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Restart {
+    Never,
+    OnFailure,
+    Always,
+}
+
+/// The `[launch]` table.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Settings {
+    pub name: String,
+    /// World file, relative to the launch file; substituted for `${world}`.
+    pub world: Option<PathBuf>,
+    /// Seed handed to services as `${seed}`.
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    /// The service whose exit ends the launch (the mission is over).
+    pub end_with: Option<Spanned<String>>,
+    #[serde(default = "default_grace_ms")]
+    pub grace_period_ms: u64,
+    #[serde(default = "default_ready_ms")]
+    pub ready_timeout_ms: u64,
+}
+
+fn default_seed() -> u64 {
+    1
+}
+fn default_grace_ms() -> u64 {
+    3000
+}
+fn default_ready_ms() -> u64 {
+    10_000
+}
+fn default_restart() -> Restart {
+    Restart::OnFailure
+}
+fn default_max_restarts() -> u32 {
+    5
+}
+fn default_window_s() -> f64 {
+    60.0
+}
+fn default_backoff_ms() -> u64 {
+    50
+}
+fn default_backoff_max_ms() -> u64 {
+    2000
+}
+
+/// One `[[service]]`.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Service {
+    pub name: Spanned<String>,
+    /// Executable: a path, or a name looked up beside `harvey` and then on `PATH`.
+    /// Default: `harvey-<name>`.
+    pub binary: Option<String>,
+    #[serde(default)]
+    pub args: Vec<String>,
+    #[serde(default = "default_restart")]
+    pub restart: Restart,
+    /// More restarts than this within `restart_window_s` stop the launch.
+    #[serde(default = "default_max_restarts")]
+    pub max_restarts: u32,
+    #[serde(default = "default_window_s")]
+    pub restart_window_s: f64,
+    /// Delay before the first restart, doubling for each further one in the window.
+    #[serde(default = "default_backoff_ms")]
+    pub backoff_ms: u64,
+    #[serde(default = "default_backoff_max_ms")]
+    pub backoff_max_ms: u64,
+}
+
+impl Service {
+    pub fn name(&self) -> &str {
+        self.name.get_ref()
+    }
+
+    pub fn binary_name(&self) -> String {
+        self.binary.clone().unwrap_or_else(|| format!("harvey-{}", self.name()))
+    }
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct File {
+    launch: Settings,
+    #[serde(rename = "service", default)]
+    services: Vec<Service>,
+    /// The executive's; not the supervisor's business.
+    #[allow(dead_code)]
+    mission: Option<toml::Value>,
+}
+
+/// A checked launch file.
+#[derive(Debug, Clone)]
+pub struct LaunchFile {
+    pub path: PathBuf,
+    pub settings: Settings,
+    pub services: Vec<Service>,
+}
+
+/// A launch file that cannot be used, with where and why.
+#[derive(Debug, thiserror::Error)]
+#[error("{file}{}: {detail}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+pub struct LaunchError {
+    pub file: String,
+    pub line: Option<usize>,
+    pub detail: String,
+}
+
+fn line_of(text: &str, offset: usize) -> usize {
+    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+}
+
+impl LaunchFile {
+    pub fn load(path: &Path) -> Result<Self, LaunchError> {
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| LaunchError {
+            file: file.clone(),
+            line: None,
+            detail: format!("cannot read: {e}"),
+        })?;
+        Self::parse(&text, path)
+    }
+
+    pub fn parse(text: &str, path: &Path) -> Result<Self, LaunchError> {
+        let file = path.display().to_string();
+        let at = |offset: usize, detail: String| LaunchError {
+            file: file.clone(),
+            line: Some(line_of(text, offset)),
+            detail,
+        };
+        let parsed: File = serde_path_to_error::deserialize(toml::Deserializer::new(text)).map_err(|e| {
+            let key = e.path().to_string();
+            let inner = e.into_inner();
+            let line = inner.span().map(|s| line_of(text, s.start));
+            LaunchError { file: file.clone(), line, detail: format!("key `{key}`: {}", inner.message()) }
+        })?;
+        if parsed.services.is_empty() {
+            return Err(LaunchError { file, line: None, detail: "no [[service]] to launch".into() });
+        }
+        for (i, s) in parsed.services.iter().enumerate() {
+            let name = s.name();
+            if name.is_empty() || !name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_') {
+                return Err(at(
+                    s.name.span().start,
+                    format!("key `service[{i}].name`: `{name}` is not a plain name"),
+                ));
+            }
+            if let Some(first) = parsed.services[..i].iter().find(|p| p.name() == name) {
+                let first_line = line_of(text, first.name.span().start);
+                return Err(at(
+                    s.name.span().start,
+                    format!(
+                        "key `service[{i}].name`: service `{name}` is already named on line {first_line}"
+                    ),
+                ));
+            }
+            if !(s.restart_window_s > 0.0) || s.backoff_ms == 0 || s.backoff_max_ms < s.backoff_ms {
+                return Err(at(
+                    s.name.span().start,
+                    format!(
+                        "service `{name}`: restart_window_s and backoff_ms must be positive, backoff_max_ms >= backoff_ms"
+                    ),
+                ));
+            }
+        }
+        if let Some(end) = &parsed.launch.end_with
+            && !parsed.services.iter().any(|s| s.name() == end.get_ref())
+        {
+            return Err(at(
+                end.span().start,
+                format!("key `launch.end_with`: no service is named `{}`", end.get_ref()),
+            ));
+        }
+        Ok(Self { path: path.to_owned(), settings: parsed.launch, services: parsed.services })
+    }
+
+    /// The world file, resolved against the launch file's folder.
+    pub fn world_path(&self) -> Option<PathBuf> {
+        let base = self.path.parent().unwrap_or(Path::new("."));
+        self.settings.world.as_ref().map(|w| base.join(w))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const OK: &str = "[launch]\nname = \"t\"\nend_with = \"b\"\n\n[[service]]\nname = \"a\"\nargs = [\"--x\", \"${seed}\"]\n\n[[service]]\nname = \"b\"\nrestart = \"never\"\n";
+
+    fn parse(text: &str) -> Result<LaunchFile, LaunchError> {
+        LaunchFile::parse(text, Path::new("m.toml"))
+    }
+
+    #[test]
+    fn a_good_file_parses_with_defaults() {
+        let l = parse(OK).expect("parses");
+        assert_eq!(l.services.len(), 2);
+        assert_eq!((l.services[0].restart, l.services[1].restart), (Restart::OnFailure, Restart::Never));
+        assert_eq!(l.services[0].binary_name(), "harvey-a");
+        assert_eq!(l.settings.seed, 1);
+    }
+
+    #[test]
+    fn errors_name_file_line_and_key() {
+        let bad = OK.replace("restart = \"never\"", "restart = \"sometimes\"");
+        let e = parse(&bad).expect_err("bad policy").to_string();
+        assert!(e.starts_with("m.toml:11: key `service[1].restart`"), "{e}");
+        let dup = OK.replace("name = \"b\"", "name = \"a\"").replace("end_with = \"b\"", "end_with = \"a\"");
+        let e = parse(&dup).expect_err("duplicate").to_string();
+        assert!(
+            e.starts_with("m.toml:10: key `service[1].name`: service `a` is already named on line 6"),
+            "{e}"
+        );
+        let e = parse(&OK.replace("end_with = \"b\"", "end_with = \"zz\"")).expect_err("unknown").to_string();
+        assert!(e.starts_with("m.toml:3: key `launch.end_with`"), "{e}");
+        let e = parse(&OK.replace("args", "argz")).expect_err("unknown key").to_string();
+        assert!(e.contains(":7: key `service[0].argz`") || e.contains(":7: key `service[0]`"), "{e}");
+    }
+}

@@ -1,0 +1,145 @@
+//! Reading a recording back: per-topic counts, rates and gaps (`harvey info`), and the mission
+//! summary `harvey run` prints, all from `run.mcap` alone.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use anyhow::Context;
+use harvey_msgs::{MissionState, MissionStatus, TruePose, UncertaintyMap};
+
+/// What one topic of a recording holds.
+#[derive(Debug, Default, Clone)]
+pub struct TopicStats {
+    pub schema: String,
+    pub messages: u64,
+    pub first_ns: u64,
+    pub last_ns: u64,
+    pub seq_gaps: Option<u64>,
+}
+
+/// A recording read back.
+#[derive(Debug, Default)]
+pub struct RunStats {
+    pub topics: BTreeMap<String, TopicStats>,
+    pub last_status: Option<MissionStatus>,
+    pub last_truth: Option<TruePose>,
+    pub last_map: Option<UncertaintyMap>,
+}
+
+impl RunStats {
+    pub fn read(path: &Path) -> anyhow::Result<Self> {
+        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+        let mut run = RunStats::default();
+        let stream = mcap::MessageStream::new(&bytes)
+            .with_context(|| format!("{}: not an MCAP file", path.display()))?;
+        for (i, m) in stream.enumerate() {
+            let m = m.with_context(|| format!("{}: corrupt after {i} messages", path.display()))?;
+            let topic = m.channel.topic.trim_start_matches('/').to_owned();
+            let t = run.topics.entry(topic.clone()).or_default();
+            if t.messages == 0 {
+                t.first_ns = m.log_time;
+                t.schema = m.channel.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default();
+            }
+            t.messages += 1;
+            t.last_ns = m.log_time;
+            let bad = |e| anyhow::anyhow!("{}: message {i} on /{topic}: {e}", path.display());
+            match topic.as_str() {
+                "executive/status" => run.last_status = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
+                "sim/truth" => run.last_truth = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
+                "ums/map" => run.last_map = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
+                _ => {}
+            }
+        }
+        if let Ok(Some(summary)) = mcap::Summary::read(&bytes) {
+            for idx in summary.metadata_indexes.iter().filter(|i| i.name == "harvey.recorder") {
+                let md = mcap::read::metadata(&bytes, idx)
+                    .with_context(|| format!("{}: recorder metadata", path.display()))?;
+                for (k, v) in &md.metadata {
+                    if let Some(topic) = k.strip_suffix(".seq_gaps")
+                        && let Some(t) = run.topics.get_mut(topic)
+                    {
+                        t.seq_gaps = v.parse().ok();
+                    }
+                }
+            }
+        }
+        Ok(run)
+    }
+
+    pub fn message_count(&self) -> u64 {
+        self.topics.values().map(|t| t.messages).sum()
+    }
+
+    /// The table `harvey info` prints.
+    pub fn info_table(&self) -> String {
+        let mut out =
+            format!("{:<22} {:>8} {:>9} {:>8}  {}\n", "topic", "messages", "rate_hz", "seq_gaps", "type");
+        for (name, t) in &self.topics {
+            let span_s = (t.last_ns.saturating_sub(t.first_ns)) as f64 / 1e9;
+            let rate = if span_s > 0.0 { (t.messages - 1) as f64 / span_s } else { 0.0 };
+            let gaps = t.seq_gaps.map_or("-".into(), |g| g.to_string());
+            out += &format!("/{name:<21} {:>8} {rate:>9.2} {gaps:>8}  {}\n", t.messages, t.schema);
+        }
+        let first = self.topics.values().map(|t| t.first_ns).min().unwrap_or(0);
+        let last = self.topics.values().map(|t| t.last_ns).max().unwrap_or(0);
+        out += &format!(
+            "{} messages over {:.2} s of simulated time\n",
+            self.message_count(),
+            (last - first) as f64 / 1e9
+        );
+        out
+    }
+
+    /// The mission summary `harvey run` prints.
+    pub fn mission_summary(&self) -> String {
+        let mut out = String::new();
+        let Some(s) = &self.last_status else {
+            return "mission: no executive status was recorded\n".into();
+        };
+        let state = match s.state() {
+            Some(MissionState::Succeeded) => "goal reached",
+            Some(MissionState::Failed) => "FAILED",
+            _ => "still running when stopped",
+        };
+        out += &format!(
+            "mission: {state} ({}/{} steps) at t = {:.2} s\n",
+            s.step,
+            s.step_count,
+            s.header.stamp_ns as f64 / 1e9
+        );
+        let g = s.goal;
+        out += &format!(
+            "  goal        x {:7.3} m  y {:7.3} m  heading {:7.2} deg\n",
+            g.x_m,
+            g.y_m,
+            g.heading_rad.to_degrees()
+        );
+        let e = s.estimated;
+        out += &format!(
+            "  estimated   x {:7.3} m  y {:7.3} m  heading {:7.2} deg\n",
+            e.x_m,
+            e.y_m,
+            e.heading_rad.to_degrees()
+        );
+        if let Some(t) = &self.last_truth {
+            let p = t.world_from_robot;
+            let err = (p.x_m - g.x_m).hypot(p.y_m - g.y_m);
+            out += &format!(
+                "  true        x {:7.3} m  y {:7.3} m  heading {:7.2} deg\n",
+                p.x_m,
+                p.y_m,
+                p.heading_rad.to_degrees()
+            );
+            out += &format!("  final error {:.3} m ({:.2} in) from the goal\n", err, err / 0.0254);
+        }
+        if let Some(m) = &self.last_map {
+            let wedge = (m.heading_ccw_rad - m.heading_cw_rad).to_degrees();
+            out += &format!("  uncertainty area {:.5} m^2, heading wedge {:.2} deg\n", m.area_m2, wedge);
+        }
+        out += &format!(
+            "  data seen by the executive: {} sonar rings, {} detections, {} maps\n",
+            s.sonar_rings_seen, s.detections_seen, s.maps_seen
+        );
+        out
+    }
+}
