@@ -142,8 +142,10 @@ pub fn run(launch: &LaunchFile, opts: &Options) -> anyhow::Result<Outcome> {
         supervise(&mut slots, launch, &env, ready, &signals)
     })();
     shutdown(&mut slots, grace);
-    let cleaned = harvey_bus::cleanup_dead_nodes(&opts.prefix).unwrap_or(0);
-    tracing::debug!(cleaned, "bus cleaned after shutdown");
+    match harvey_bus::retire_domain(&opts.prefix) {
+        Ok(n) => tracing::debug!(removed = n, "bus domain retired"),
+        Err(e) => tracing::warn!("bus domain not retired: {e}"),
+    }
     outcome
 }
 

@@ -128,3 +128,28 @@ pub fn cleanup_dead_nodes(prefix: &str) -> Result<usize> {
     }
     Ok(cleaned)
 }
+
+/// Removes every trace of a domain once none of its nodes lives: dead nodes' resources, then the
+/// shared-memory objects iceoryx2 keeps per prefix (its global management segment). Refuses while
+/// a node is alive. Returns how many shared-memory objects were removed.
+pub fn retire_domain(prefix: &str) -> Result<usize> {
+    let alive: Vec<NodeInfo> = live_nodes(prefix)?.into_iter().filter(|n| n.alive).collect();
+    if !alive.is_empty() {
+        return Err(BusError::Node {
+            node: alive.iter().map(|n| n.name.as_str()).collect::<Vec<_>>().join(", "),
+            detail: format!("still alive in domain `{prefix}`"),
+        });
+    }
+    cleanup_dead_nodes(prefix)?;
+    let mut removed = 0;
+    if let Ok(dir) = std::fs::read_dir("/dev/shm") {
+        for entry in dir.flatten() {
+            if entry.file_name().to_string_lossy().starts_with(prefix)
+                && std::fs::remove_file(entry.path()).is_ok()
+            {
+                removed += 1;
+            }
+        }
+    }
+    Ok(removed)
+}

@@ -16,7 +16,7 @@ mod pubsub;
 mod waiter;
 
 pub use domain::{
-    Bus, DEFAULT_PREFIX, NodeInfo, PREFIX_ENV, cleanup_dead_nodes, live_nodes, validate_prefix,
+    Bus, DEFAULT_PREFIX, NodeInfo, PREFIX_ENV, cleanup_dead_nodes, live_nodes, retire_domain, validate_prefix,
 };
 pub use error::BusError;
 pub use frames::{Frame, FrameLoan, FramePublisher, FrameSubscriber};

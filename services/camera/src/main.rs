@@ -28,7 +28,7 @@ struct Args {
     #[arg(long, default_value_t = 2)]
     every: u64,
     /// Render from this fixed pose `x_m,y_m,heading_deg` instead of following `sim/truth`.
-    #[arg(long, value_delimiter = ',', num_args = 3)]
+    #[arg(long, value_delimiter = ',')]
     pose: Option<Vec<f64>>,
     /// With `--pose`: frames per second (wall clock), and how many to send (0: until stopped).
     #[arg(long, default_value_t = 10.0)]
@@ -76,6 +76,7 @@ fn main() -> anyhow::Result<()> {
     let waiter = Waiter::new()?;
 
     if let Some(p) = args.pose {
+        anyhow::ensure!(p.len() == 3, "--pose takes x_m,y_m,heading_deg; got {} values", p.len());
         anyhow::ensure!(args.rate_hz > 0.0, "--rate-hz must be positive");
         let pose = [p[0], p[1], p[2].to_radians()];
         let _tick = waiter.attach_interval(Duration::from_secs_f64(1.0 / args.rate_hz))?;

@@ -1,0 +1,98 @@
+//! Helpers shared by the multi-process tests: where the built binaries are, a bus prefix and a
+//! scratch folder unique to each test, and checks that nothing is left behind.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+/// The folder holding the workspace's binaries (the test runs from `<target>/<profile>/deps`).
+pub fn bin_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    exe.parent().and_then(Path::parent).expect("target folder").to_owned()
+}
+
+pub fn bin(name: &str) -> PathBuf {
+    let p = bin_dir().join(name);
+    assert!(p.is_file(), "{} is not built: run `cargo build --release --workspace` first", p.display());
+    p
+}
+
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// A bus prefix no other test or run uses, so tests run in parallel and a killed test's
+/// leftovers never meet the next run.
+pub fn unique_prefix(tag: &str) -> String {
+    static N: AtomicU32 = AtomicU32::new(0);
+    format!("t{}{}{}_", tag, std::process::id(), N.fetch_add(1, Ordering::Relaxed))
+}
+
+/// A fresh scratch folder under the target directory.
+pub fn scratch(tag: &str) -> PathBuf {
+    let d = bin_dir().join("test-scratch").join(format!("{tag}-{}", unique_prefix("")));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).expect("scratch folder");
+    d
+}
+
+/// Shared-memory objects of a bus prefix still in /dev/shm.
+pub fn shm_leftovers(prefix: &str) -> Vec<String> {
+    std::fs::read_dir("/dev/shm")
+        .map(|d| {
+            d.filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| n.starts_with(prefix))
+                .collect()
+        })
+        .unwrap_or_default()
+}
+
+/// Processes whose environment carries this bus prefix (children that outlived the test).
+pub fn processes_with_prefix(prefix: &str) -> Vec<u32> {
+    let needle = format!("{}={prefix}", harvey_bus::PREFIX_ENV);
+    std::fs::read_dir("/proc")
+        .into_iter()
+        .flatten()
+        .filter_map(|e| e.ok()?.file_name().to_str()?.parse::<u32>().ok())
+        .filter(|pid| {
+            std::fs::read(format!("/proc/{pid}/environ"))
+                .map(|env| env.split(|&b| b == 0).any(|kv| kv == needle.as_bytes()))
+                .unwrap_or(false)
+        })
+        .filter(|pid| {
+            // Zombies are not running; they only wait to be reaped.
+            std::fs::read_to_string(format!("/proc/{pid}/stat")).map(|s| !s.contains(") Z ")).unwrap_or(false)
+        })
+        .collect()
+}
+
+/// Waits for a child to exit, up to `timeout`; kills it and fails the test if it does not.
+pub fn wait_exit(child: &mut Child, timeout: Duration) -> std::process::ExitStatus {
+    let deadline = Instant::now() + timeout;
+    loop {
+        if let Some(s) = child.try_wait().expect("try_wait") {
+            return s;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("process {} did not exit within {timeout:?}", child.id());
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+pub fn signal(child: &Child, sig: i32) {
+    // SAFETY: plain kill(2) on our own child.
+    unsafe { libc::kill(child.id() as i32, sig) };
+}
+
+/// `harvey` with the given arguments, run from the repository root.
+pub fn harvey(args: &[&str]) -> Command {
+    let mut c = Command::new(bin("harvey"));
+    c.args(args).current_dir(repo());
+    c
+}
