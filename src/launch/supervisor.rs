@@ -109,12 +109,16 @@ pub fn run(launch: &LaunchFile, opts: &Options) -> anyhow::Result<Outcome> {
             restart_at: None,
         });
     }
-    let alive: Vec<_> = harvey_bus::live_nodes(&opts.prefix)?.into_iter().filter(|n| n.alive).collect();
+    // Observers (tools, tests) may already be on the bus; live copies of our services may not.
+    let clashes: Vec<_> = harvey_bus::live_nodes(&opts.prefix)?
+        .into_iter()
+        .filter(|n| n.alive && launch.services.iter().any(|s| s.name() == n.name))
+        .collect();
     anyhow::ensure!(
-        alive.is_empty(),
-        "bus prefix `{}` is in use by live processes {:?}: is another launch running?",
+        clashes.is_empty(),
+        "bus prefix `{}` already runs {:?}: is another launch running?",
         opts.prefix,
-        alive
+        clashes
     );
     let cleaned = harvey_bus::cleanup_dead_nodes(&opts.prefix)?;
     if cleaned > 0 {
