@@ -168,7 +168,7 @@ impl LaunchFile {
                     ),
                 ));
             }
-            if !(s.restart_window_s > 0.0) || s.backoff_ms == 0 || s.backoff_max_ms < s.backoff_ms {
+            if !greater(s.restart_window_s, 0.0) || s.backoff_ms == 0 || s.backoff_max_ms < s.backoff_ms {
                 return Err(at(
                     s.name.span().start,
                     format!(
@@ -193,6 +193,11 @@ impl LaunchFile {
         let base = self.path.parent().unwrap_or(Path::new("."));
         self.settings.world.as_ref().map(|w| base.join(w))
     }
+}
+
+/// `v > min`, false for NaN: the check that a number is usable.
+fn greater(v: f64, min: f64) -> bool {
+    v > min
 }
 
 #[cfg(test)]

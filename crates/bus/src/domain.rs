@@ -95,11 +95,7 @@ pub fn live_nodes(prefix: &str) -> Result<Vec<NodeInfo>> {
             NodeState::Inaccessible(_) | NodeState::Undefined(_) => (None, false),
         };
         if let Some(d) = view_details {
-            nodes.push(NodeInfo {
-                name: d.name().as_str().to_owned(),
-                pid: d.process_id().value() as i32,
-                alive,
-            });
+            nodes.push(NodeInfo { name: d.name().as_str().to_owned(), pid: d.process_id().value(), alive });
         }
         CallbackProgression::Continue
     })

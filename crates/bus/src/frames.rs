@@ -88,6 +88,11 @@ impl FrameLoan<'_> {
         self.sample.user_header()
     }
 
+    /// Replaces the header, e.g. to stamp the frame once its pixels are written.
+    pub fn set_header(&mut self, header: FrameHeader) {
+        *self.sample.user_header_mut() = header;
+    }
+
     /// The pixels, in shared memory: render straight into them.
     pub fn pixels_mut(&mut self) -> &mut [u8] {
         self.sample.payload_mut()

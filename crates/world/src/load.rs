@@ -39,7 +39,7 @@ fn check(w: &World) -> Result<(), String> {
         return Err("a world needs at least one wall".into());
     }
     for (i, wall) in w.walls.iter().enumerate() {
-        if !(wall.length_m() > 1e-6) || !(wall.height_m > 0.0) {
+        if !greater(wall.length_m(), 1e-6) || !greater(wall.height_m, 0.0) {
             return Err(format!("wall[{i}] has no length or height"));
         }
         for (j, r) in wall.regions.iter().enumerate() {
@@ -49,17 +49,22 @@ fn check(w: &World) -> Result<(), String> {
         }
     }
     let c = &w.camera;
-    if c.width_px == 0 || c.height_px == 0 || !(c.focal_px > 0.0) || !(c.height_m > 0.0) {
+    if c.width_px == 0 || c.height_px == 0 || !greater(c.focal_px, 0.0) || !greater(c.height_m, 0.0) {
         return Err("camera needs a positive size, focal length and height".into());
     }
     let r = &w.robot;
-    if !(r.speed_mps > 0.0) || !(r.turn_rate_degps > 0.0) || !(r.sonar_max_range_ft > 0.0) {
+    if !greater(r.speed_mps, 0.0) || !greater(r.turn_rate_degps, 0.0) || !greater(r.sonar_max_range_ft, 0.0) {
         return Err("robot speeds and sonar range must be positive".into());
     }
-    if !(w.floor.tile_m > 0.0) {
+    if !greater(w.floor.tile_m, 0.0) {
         return Err("floor tiles must have a positive size".into());
     }
     Ok(())
+}
+
+/// `v > min`, false for NaN: the check that a number is usable.
+fn greater(v: f64, min: f64) -> bool {
+    v > min
 }
 
 #[cfg(test)]

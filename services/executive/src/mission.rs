@@ -34,7 +34,7 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
     let parsed: File = serde_path_to_error::deserialize(only_mission)
         .map_err(|e| format!("{file}: field `{}`: {}", e.path(), e.inner().message()))?;
     let m = parsed.mission.ok_or_else(|| format!("{file}: no [mission] table"))?;
-    if !(m.timeout_s > 0.0) {
+    if !greater(m.timeout_s, 0.0) {
         return Err(format!("{file}: mission.timeout_s must be positive"));
     }
     if m.steps.is_empty() {
@@ -51,6 +51,11 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
         }
     }
     Ok(m)
+}
+
+/// `v > min`, false for NaN: the check that a number is usable.
+fn greater(v: f64, min: f64) -> bool {
+    v > min
 }
 
 #[cfg(test)]
