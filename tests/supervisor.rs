@@ -134,6 +134,10 @@ fn a_killed_service_is_restarted_and_the_others_never_stop() {
     let (status, text) = output(sup, Duration::from_secs(30));
     assert_eq!(status.code(), Some(130), "{text}");
     assert!(text.contains("exited with SIGKILL: restart 1"), "{text}");
+    assert!(
+        text.contains("restarted service=sonar") && text.contains("cleaned=1"),
+        "dead node's resources cleaned: {text}"
+    );
     assert!(!alive(new_pid) && others.iter().all(|(_, p)| !alive(*p)), "children outlived the supervisor");
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new(), "stale shared memory");
 }
@@ -212,4 +216,29 @@ fn a_crash_looping_service_exhausts_its_restarts_and_ends_the_launch() {
     assert!(out.contains("GaveUp { service: \"flaky\" }"), "{out}");
     assert_eq!(common::processes_with_prefix(&prefix), Vec::<u32>::new(), "orphans");
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new(), "stale shared memory");
+}
+
+#[test]
+fn a_service_ignoring_sigterm_is_killed_after_the_grace_period_with_its_helpers() {
+    let prefix = common::unique_prefix("grace");
+    let dir = common::scratch("grace");
+    let text = "[launch]\nname = \"grace\"\ngrace_period_ms = 300\n\n[[service]]\nname = \"stubborn\"\nbinary = \"/bin/sh\"\nargs = [\"-c\", \"trap '' TERM; echo READY >&3; sleep 100; true\"]\n";
+    let sup = launch(&write_launch(&dir, text), &prefix, &dir);
+    let deadline = Instant::now() + Duration::from_secs(20);
+    // The shell and its `sleep` both carry the bus prefix in their environment.
+    while common::processes_with_prefix(&prefix).len() < 2 {
+        assert!(Instant::now() < deadline, "the stubborn service never started");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    common::signal(&sup, libc::SIGINT);
+    let (status, out) = output(sup, Duration::from_secs(20));
+    assert_eq!(status.code(), Some(130), "{out}");
+    assert!(out.contains("did not stop within 300 ms: SIGKILL"), "{out}");
+    assert!(out.contains("stopped: SIGKILL service=stubborn"), "{out}");
+    std::thread::sleep(Duration::from_millis(100));
+    assert_eq!(
+        common::processes_with_prefix(&prefix),
+        Vec::<u32>::new(),
+        "the helper `sleep` outlived its service"
+    );
 }

@@ -128,13 +128,15 @@ fn pipe_fd(fd: &OwnedFd) -> std::os::fd::BorrowedFd<'_> {
     fd.as_fd()
 }
 
-/// SIGTERM, then SIGKILL after `grace`; reaps the child and returns how it ended.
+/// SIGTERM to the child's process group, then SIGKILL after `grace`; reaps the child and returns
+/// how it ended.
 pub fn stop(r: &mut Running, grace: Duration) -> ExitStatus {
     if let Ok(Some(status)) = r.child.try_wait() {
         return status;
     }
-    let pid = Pid::from_raw(r.child.id() as i32);
-    let _ = kill(pid, Signal::SIGTERM);
+    // The child leads its own process group: signal the group, so helpers it started go too.
+    let group = Pid::from_raw(-(r.child.id() as i32));
+    let _ = kill(group, Signal::SIGTERM);
     let deadline = Instant::now() + grace;
     while Instant::now() < deadline {
         if let Ok(Some(status)) = r.child.try_wait() {
@@ -143,6 +145,6 @@ pub fn stop(r: &mut Running, grace: Duration) -> ExitStatus {
         std::thread::sleep(Duration::from_millis(10));
     }
     tracing::warn!(service = %r.name, "did not stop within {} ms: SIGKILL", grace.as_millis());
-    let _ = r.child.kill();
+    let _ = kill(group, Signal::SIGKILL);
     r.child.wait().unwrap_or_else(|_| ExitStatus::from_raw(libc::SIGKILL))
 }

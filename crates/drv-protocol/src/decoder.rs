@@ -150,7 +150,14 @@ mod tests {
     fn the_documented_example_frames_are_exact() {
         assert_eq!(encode(&Line::Command(Command::Move { id: 1, hundredths_ft: 400 })), "$MV 1 400*1E\r\n");
         assert_eq!(encode(&Line::Report(Report::Ack { id: 1 })), "$AK 1*1B\r\n");
-        let en = Report::Encoders { time_ms: 1250, x_hundredths_ft: 41, y_hundredths_ft: 0, heading_tenths_deg: 0, moving: true, command_id: 1 };
+        let en = Report::Encoders {
+            time_ms: 1250,
+            x_hundredths_ft: 41,
+            y_hundredths_ft: 0,
+            heading_tenths_deg: 0,
+            moving: true,
+            command_id: 1,
+        };
         assert_eq!(encode(&Line::Report(en)), "$EN 1250 41 0 0 1 1*08\r\n");
     }
 
