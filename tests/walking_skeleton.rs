@@ -31,6 +31,7 @@ fn the_default_mission_runs_records_and_cleans_up() {
     assert!(out.status.success(), "harvey run failed ({}):\n{stdout}\n{stderr}", out.status);
     assert!(stdout.contains("mission: goal reached (3/3 steps)"), "{stdout}");
 
+    assert!(!stderr.contains("exited with"), "a service failed during the mission:\n{stderr}");
     // Every service ran and stopped in reverse order of start.
     let started: Vec<&str> = [
         "recorder",

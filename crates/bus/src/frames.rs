@@ -147,11 +147,15 @@ impl FrameSubscriber {
         Ok(receive()?.map(|sample| Frame { sample }))
     }
 
-    /// The newest queued frame, releasing older ones.
+    /// The newest queued frame, releasing older ones first (a subscriber may hold only
+    /// `Qos::borrowed` frames at once).
     pub fn latest(&self) -> Result<Option<Frame>> {
-        let mut last = None;
-        while let Some(frame) = self.take()? {
-            last = Some(frame);
+        let mut last = self.take()?;
+        while last.is_some()
+            && self.port.has_samples().map_err(|e| BusError::topic(self.topic, "cannot receive", e))?
+        {
+            drop(last.take());
+            last = self.take()?;
         }
         Ok(last)
     }

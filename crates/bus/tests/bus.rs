@@ -51,6 +51,19 @@ fn frames_are_loaned_written_and_read_in_place() {
         let frame = sub.take().expect("take").expect("a frame");
         assert_eq!(frame.header().seq, 1);
         assert!(frame.pixels().iter().enumerate().all(|(i, p)| *p == (i % 256) as u8));
+        drop(frame);
+        // Several queued: `latest` releases the older ones before it takes the next, so it
+        // never holds more frames than the topic lets a subscriber borrow.
+        for seq in 2..=4 {
+            let mut loan = publ.loan(FrameHeader::new(seq, seq, 64, 48, Encoding::Mono8)).expect("loan");
+            loan.pixels_mut().fill(seq as u8);
+            loan.send().expect("send");
+        }
+        let newest = sub.latest().expect("no borrow overflow").expect("a frame");
+        assert_eq!(newest.header().seq, 4);
+        assert!(newest.pixels().iter().all(|p| *p == 4));
+        drop(newest);
+        assert!(sub.latest().expect("empty").is_none());
         let too_big = publ.loan(FrameHeader::new(2, 6, 65, 48, Encoding::Mono8));
         assert!(matches!(too_big, Err(BusError::Topic { what: "frame size out of range", .. })));
     }
