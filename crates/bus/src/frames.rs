@@ -11,7 +11,7 @@ use iceoryx2::sample_mut::SampleMut;
 
 use harvey_msgs::{FrameHeader, FrameTopic};
 
-use crate::pubsub::{event_ports, max_nodes, open_error};
+use crate::pubsub::{apply_qos, event_ports, open_error};
 use crate::{Bus, BusError, Result};
 
 fn open_frame_service(
@@ -20,19 +20,12 @@ fn open_frame_service(
 ) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, [u8], FrameHeader>>
 {
     let qos = topic.qos;
-    bus.node
+    let builder = bus
+        .node
         .service_builder(&Bus::service_name(topic.name)?)
         .publish_subscribe::<[u8]>()
-        .user_header::<FrameHeader>()
-        .history_size(qos.history)
-        .subscriber_max_buffer_size(qos.buffer)
-        .subscriber_max_borrowed_samples(qos.borrowed)
-        .enable_safe_overflow(true)
-        .max_publishers(qos.max_publishers)
-        .max_subscribers(qos.max_subscribers)
-        .max_nodes(max_nodes(qos))
-        .open_or_create()
-        .map_err(|e| open_error(topic.name, e))
+        .user_header::<FrameHeader>();
+    apply_qos!(builder, qos).open_or_create().map_err(|e| open_error(topic.name, e))
 }
 
 /// Publishes camera frames of at most `max_frame_bytes` bytes.

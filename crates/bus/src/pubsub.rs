@@ -41,23 +41,28 @@ pub(crate) fn max_nodes(qos: Qos) -> usize {
     qos.max_publishers + qos.max_subscribers + 2
 }
 
+/// Applies a topic's [`Qos`] to a publish-subscribe service builder of any payload type.
+macro_rules! apply_qos {
+    ($builder:expr, $qos:expr) => {
+        $builder
+            .history_size($qos.history)
+            .subscriber_max_buffer_size($qos.buffer)
+            .subscriber_max_borrowed_samples($qos.borrowed)
+            .enable_safe_overflow(true)
+            .max_publishers($qos.max_publishers)
+            .max_subscribers($qos.max_subscribers)
+            .max_nodes(crate::pubsub::max_nodes($qos))
+    };
+}
+pub(crate) use apply_qos;
+
 fn open_service<T: Message>(
     bus: &Bus,
     topic: Topic<T>,
 ) -> Result<iceoryx2::service::port_factory::publish_subscribe::PortFactory<ipc::Service, T, ()>> {
     let qos = topic.qos;
-    bus.node
-        .service_builder(&Bus::service_name(topic.name)?)
-        .publish_subscribe::<T>()
-        .history_size(qos.history)
-        .subscriber_max_buffer_size(qos.buffer)
-        .subscriber_max_borrowed_samples(qos.borrowed)
-        .enable_safe_overflow(true)
-        .max_publishers(qos.max_publishers)
-        .max_subscribers(qos.max_subscribers)
-        .max_nodes(max_nodes(qos))
-        .open_or_create()
-        .map_err(|e| open_error(topic.name, e))
+    let builder = bus.node.service_builder(&Bus::service_name(topic.name)?).publish_subscribe::<T>();
+    apply_qos!(builder, qos).open_or_create().map_err(|e| open_error(topic.name, e))
 }
 
 /// Publishes messages of type `T` on one topic.

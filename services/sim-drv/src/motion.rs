@@ -147,18 +147,10 @@ pub fn advance(m: &mut Motion, t: &Terrain, truth: Pose, enc: Pose, dt_s: f64) -
 mod tests {
     use super::*;
 
+    /// Tile, from the hallway world's copy of 002 Table 3.
     fn tile() -> Terrain {
-        Terrain {
-            translational_loss_ft_per_ft: 0.042,
-            inertial_loss_ft: 0.0084,
-            translational_sd_ft_per_ft: 0.0028,
-            drift_deg_per_ft: 0.27,
-            drift_sd_deg_per_ft: 0.12,
-            rotational_loss_deg_per_deg: 0.018,
-            rotational_sd_deg_per_deg: 0.006,
-            skitter_ft_per_deg: 0.0013,
-            skitter_sd_ft_per_deg: 0.00013,
-        }
+        let world = include_str!("../../../worlds/hallway.toml");
+        harvey_world::load_str(world, "hallway.toml").expect("hallway loads").terrain["tile"].clone()
     }
 
     #[test]
