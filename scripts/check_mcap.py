@@ -29,9 +29,9 @@ def main() -> int:
         print(f"  {topic:<22} {n:>7} messages decoded")
     if missing:
         print(f"{path}: no messages on {missing}")
-        return 1
     print(f"mcap-ros2-support decoded all {sum(counts.values())} messages on {len(counts)} channels")
-    return 0
+    print(f"check_mcap: {len(expected) - len(missing)} passed, {len(missing)} failed")
+    return 1 if missing else 0
 
 
 if __name__ == "__main__":
