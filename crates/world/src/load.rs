@@ -90,6 +90,14 @@ mod tests {
     }
 
     #[test]
+    fn the_campus_has_all_four_terrains_of_table_3() {
+        let w = load_str(include_str!("../../../worlds/campus.toml"), "campus.toml").expect("campus loads");
+        let names: Vec<&str> = w.terrain.keys().map(String::as_str).collect();
+        assert_eq!(names, ["concrete", "dry_grass", "gravel", "tile"]);
+        assert!((w.terrain["dry_grass"].translational_sd_ft_per_ft - 0.0042).abs() < 1e-12);
+    }
+
+    #[test]
     fn an_unknown_ground_is_inconsistent() {
         let text = HALLWAY.replacen("ground = \"tile\"", "ground = \"ice\"", 1);
         let err = load_str(&text, "w.toml").expect_err("must fail").to_string();
