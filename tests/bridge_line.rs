@@ -23,13 +23,13 @@ impl Lcg {
 }
 
 fn report(i: u64) -> Report {
-    if i % 2 == 0 {
+    if i.is_multiple_of(2) {
         Report::Encoders {
             time_ms: i * 50,
             x_hundredths_ft: i as i32 * 3,
             y_hundredths_ft: -(i as i32),
             heading_tenths_deg: (i % 3600) as i32,
-            moving: i % 4 == 0,
+            moving: i.is_multiple_of(4),
             command_id: 7,
         }
     } else {
