@@ -100,6 +100,12 @@ pub struct Camera {
     pub height_m: f64,
     /// Scene illumination: a pixel is `illumination x reflectance`, clamped to 255.
     pub illumination: f64,
+    /// Uneven lighting: the image corners receive `1 - vignetting` of the centre's light.
+    #[serde(default)]
+    pub vignetting: f64,
+    /// Sensor noise, standard deviation in grey levels (seeded per frame).
+    #[serde(default)]
+    pub noise_sd: f64,
 }
 
 /// A whole world.

@@ -2,6 +2,9 @@
 //! camera, pixel = illumination x reflectance, written straight into the caller's buffer (the
 //! loaned shared-memory slice).
 
+mod effects;
+
+pub use effects::Effects;
 use harvey_msgs::Encoding;
 use harvey_world::World;
 

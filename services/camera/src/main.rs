@@ -7,7 +7,7 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, FramePublisher, Waiter, Wake};
-use harvey_camera::{Renderer, checksum};
+use harvey_camera::{Effects, Renderer, checksum};
 use harvey_msgs::{Encoding, FrameHeader, topics};
 use harvey_world::World;
 
@@ -35,11 +35,15 @@ struct Args {
     rate_hz: f64,
     #[arg(long, default_value_t = 0)]
     frames: u64,
+    /// Seed of the sensor noise (the world's camera sets how much).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
 }
 
 struct Camera {
     world: World,
     renderer: Renderer,
+    effects: Effects,
     publisher: FramePublisher,
     seq: u64,
 }
@@ -51,6 +55,12 @@ impl Camera {
         let header = FrameHeader::new(self.seq, stamp_ns, r.width_px(), r.height_px(), r.encoding());
         let mut frame = self.publisher.loan(header)?;
         self.renderer.render(&self.world, pose, frame.pixels_mut()).map_err(anyhow::Error::msg)?;
+        let (w, h, bpp) = (
+            header.width_px as usize,
+            header.height_px as usize,
+            header.stride_bytes as usize / header.width_px as usize,
+        );
+        self.effects.apply(w, h, bpp, self.seq, frame.pixels_mut());
         tracing::debug!(seq = self.seq, checksum = checksum(frame.pixels_mut()), "frame");
         frame.send()?;
         Ok(())
@@ -72,7 +82,9 @@ fn main() -> anyhow::Result<()> {
     let renderer = Renderer::new(&world, width, height, encoding);
     let bus = Bus::join("camera")?;
     let publisher = bus.frame_publisher(topics::CAMERA_FRAME, renderer.frame_bytes())?;
-    let mut cam = Camera { world, renderer, publisher, seq: 0 };
+    let effects =
+        Effects { vignetting: world.camera.vignetting, noise_sd: world.camera.noise_sd, seed: args.seed };
+    let mut cam = Camera { world, renderer, effects, publisher, seq: 0 };
     let waiter = Waiter::new()?;
 
     if let Some(p) = args.pose {
