@@ -1,16 +1,16 @@
 //! Harvey's world model: planar walls with reflectance regions, the floor, terrain error
 //! statistics, the robot's sonar and drive, and the camera; loaded from TOML and ray cast.
 //!
-//! This is the first version the walking skeleton needs; locales, landmarks and meadows come
-//! with the simulator issue.
 
 mod load;
 mod model;
 mod raycast;
+pub mod topology;
 
 pub use load::{WorldError, load_str};
 pub use model::*;
 pub use raycast::Hit;
+pub use topology::{Door, Landmark, LandmarkClass, Locale, Meadow, Strategy};
 
 impl World {
     /// Loads a world file; errors name the file, line and field.

@@ -59,6 +59,80 @@ fn check(w: &World) -> Result<(), String> {
     if !greater(w.floor.tile_m, 0.0) {
         return Err("floor tiles must have a positive size".into());
     }
+    check_topology(w)
+}
+
+fn unique<'a>(what: &str, names: impl Iterator<Item = &'a str>) -> Result<(), String> {
+    let mut seen = std::collections::BTreeSet::new();
+    for n in names {
+        if !seen.insert(n) {
+            return Err(format!("two {what}s are named `{n}`"));
+        }
+    }
+    Ok(())
+}
+
+fn check_topology(w: &World) -> Result<(), String> {
+    unique("locale", w.locales.iter().map(|l| l.name.as_str()))?;
+    unique("meadow", w.meadows.iter().map(|m| m.name.as_str()))?;
+    unique("landmark", w.landmarks.iter().map(|l| l.name.as_str()))?;
+    let locale = |n: &str| w.locales.iter().find(|l| l.name == n);
+    for l in &w.locales {
+        let mut seen = vec![l.name.as_str()];
+        let mut parent = l.part_of.as_deref();
+        while let Some(p) = parent {
+            let up = locale(p).ok_or(format!("locale `{}` is part of missing locale `{p}`", l.name))?;
+            if seen.contains(&p) {
+                return Err(format!("locale `{}` is part of itself through {seen:?}", l.name));
+            }
+            seen.push(p);
+            parent = up.part_of.as_deref();
+        }
+        if !l.outline.is_empty() && l.outline.len() < 3 {
+            return Err(format!("locale `{}` has an outline of fewer than 3 points", l.name));
+        }
+    }
+    for (i, d) in w.doors.iter().enumerate() {
+        for n in &d.between {
+            if locale(n).is_none() {
+                return Err(format!("door[{i}] leads to missing locale `{n}`"));
+            }
+        }
+        if !greater(d.width_m, 0.0) {
+            return Err(format!("door[{i}] has no width"));
+        }
+    }
+    for m in &w.meadows {
+        if !w.terrain.contains_key(&m.terrain) {
+            return Err(format!(
+                "meadow `{}` has terrain `{}`, which is not in the terrain table",
+                m.name, m.terrain
+            ));
+        }
+        if m.outline.len() < 3 {
+            return Err(format!("meadow `{}` has an outline of fewer than 3 points", m.name));
+        }
+        if let Some(l) = m.landmarks.iter().find(|l| w.landmark(l).is_none()) {
+            return Err(format!("meadow `{}` lists missing landmark `{l}`", m.name));
+        }
+    }
+    for l in &w.landmarks {
+        if !w.meadows.iter().any(|m| m.landmarks.contains(&l.name)) {
+            return Err(format!("landmark `{}` lies outside every meadow (no meadow lists it)", l.name));
+        }
+        if !greater(l.activation_range_m, 0.0) {
+            return Err(format!("landmark `{}` has no activation range", l.name));
+        }
+        match l.class {
+            crate::LandmarkClass::I if !greater(l.height_m, 0.0) => {
+                return Err(format!("class I landmark `{}` needs a height_m", l.name));
+            }
+            crate::LandmarkClass::III if l.to_m.is_none() => {
+                return Err(format!("class III landmark `{}` needs a to_m end", l.name));
+            }
+            _ => {}
+        }
+    }
     Ok(())
 }
 
@@ -95,6 +169,64 @@ mod tests {
         let names: Vec<&str> = w.terrain.keys().map(String::as_str).collect();
         assert_eq!(names, ["concrete", "dry_grass", "gravel", "tile"]);
         assert!((w.terrain["dry_grass"].translational_sd_ft_per_ft - 0.0042).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_hallway_has_locales_doors_meadows_and_landmarks() {
+        let w = load_str(HALLWAY, "hallway.toml").expect("hallway loads");
+        assert_eq!(w.locale_at(3.0, 0.0).map(|l| l.name.as_str()), Some("hallway"));
+        assert_eq!(w.locale_at(5.0, 3.0).map(|l| l.name.as_str()), Some("robot-lab"));
+        assert_eq!(w.locale_at(12.0, 2.0).map(|l| l.name.as_str()), Some("teds-office"));
+        assert_eq!(
+            w.locales.iter().find(|l| l.name == "robot-lab").and_then(|l| l.part_of.as_deref()),
+            Some("grc")
+        );
+        assert_eq!(w.doors.len(), 2);
+        // The lab's floor is concrete, the hall's tile (Table 3's numbers differ).
+        assert!((w.terrain_at(5.0, 3.0).translational_loss_ft_per_ft - 0.044).abs() < 1e-12);
+        assert!((w.terrain_at(5.0, 0.0).translational_loss_ft_per_ft - 0.042).abs() < 1e-12);
+        let sign = w.landmark("office-sign").expect("sign");
+        assert_eq!(sign.class, crate::LandmarkClass::II);
+        assert!(sign.active_from(6.0, 0.0, 0.0) && !sign.active_from(6.0, 0.0, 180.0));
+        // The 40+ ft hall of 000 §5.5.
+        assert!(w.walls.iter().any(|wall| wall.length_m() / 0.3048 > 40.0));
+    }
+
+    #[test]
+    fn inconsistent_worlds_are_rejected_with_the_reason() {
+        let cases =
+            [
+                (
+                    HALLWAY.replacen(
+                        "between = [\"hallway\", \"robot-lab\"]",
+                        "between = [\"hallway\", \"attic\"]",
+                        1,
+                    ),
+                    "door[0] leads to missing locale `attic`",
+                ),
+                (
+                    HALLWAY
+                        .replacen("landmarks = [\"office-door-west-jamb\"]", "landmarks = []", 1)
+                        .replacen(", \"office-door-west-jamb\"", "", 1),
+                    "landmark `office-door-west-jamb` lies outside every meadow",
+                ),
+                (
+                    HALLWAY.replacen("part_of = \"grc\"", "part_of = \"campus\"", 1),
+                    "locale `hallway` is part of missing locale `campus`",
+                ),
+                (
+                    HALLWAY.replacen("terrain = \"concrete\"", "terrain = \"ice\"", 1),
+                    "meadow `robot-lab-floor` has terrain `ice`",
+                ),
+                (
+                    HALLWAY.replacen("to_m = [16.0, 1.0, 0.0]\n", "", 1),
+                    "class III landmark `north-baseboard` needs a to_m end",
+                ),
+            ];
+        for (text, reason) in cases {
+            let err = load_str(&text, "w.toml").expect_err(reason).to_string();
+            assert!(err.starts_with("w.toml: inconsistent world: ") && err.contains(reason), "{err}");
+        }
     }
 
     #[test]

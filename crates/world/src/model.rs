@@ -2,6 +2,12 @@
 
 use serde::Deserialize;
 
+use crate::topology::{Door, Landmark, Locale, Meadow, contains, signed_area};
+
+fn white() -> [f64; 3] {
+    [1.0, 1.0, 1.0]
+}
+
 /// A planar pose in the world frame.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -20,6 +26,9 @@ pub struct Region {
     /// Height above the floor.
     pub height_m: [f64; 2],
     pub reflectance: f64,
+    /// Relative colour (red, green, blue in 0..=1) multiplying the reflectance in colour images.
+    #[serde(default = "white")]
+    pub colour: [f64; 3],
 }
 
 /// A vertical planar face standing on the floor, from `from` to `to`.
@@ -30,6 +39,8 @@ pub struct Wall {
     pub to: [f64; 2],
     pub height_m: f64,
     pub reflectance: f64,
+    #[serde(default = "white")]
+    pub colour: [f64; 3],
     #[serde(default, rename = "region")]
     pub regions: Vec<Region>,
 }
@@ -39,9 +50,9 @@ impl Wall {
         (self.to[0] - self.from[0]).hypot(self.to[1] - self.from[1])
     }
 
-    /// Reflectance at `along_m` from `from`, `z_m` above the floor: the last region containing
-    /// the point wins, else the wall's own.
-    pub fn reflectance_at(&self, along_m: f64, z_m: f64) -> f64 {
+    /// Reflectance and colour at `along_m` from `from`, `z_m` above the floor: the last region
+    /// containing the point wins, else the wall's own.
+    pub fn appearance_at(&self, along_m: f64, z_m: f64) -> (f64, [f64; 3]) {
         self.regions
             .iter()
             .rev()
@@ -49,7 +60,12 @@ impl Wall {
                 (r.along_m[0]..=r.along_m[1]).contains(&along_m)
                     && (r.height_m[0]..=r.height_m[1]).contains(&z_m)
             })
-            .map_or(self.reflectance, |r| r.reflectance)
+            .map_or((self.reflectance, self.colour), |r| (r.reflectance, r.colour))
+    }
+
+    /// Reflectance at `along_m` from `from`, `z_m` above the floor.
+    pub fn reflectance_at(&self, along_m: f64, z_m: f64) -> f64 {
+        self.appearance_at(along_m, z_m).0
     }
 }
 
@@ -122,12 +138,43 @@ pub struct World {
     pub terrain: std::collections::BTreeMap<String, Terrain>,
     #[serde(rename = "wall")]
     pub walls: Vec<Wall>,
+    #[serde(default, rename = "locale")]
+    pub locales: Vec<Locale>,
+    #[serde(default, rename = "door")]
+    pub doors: Vec<Door>,
+    #[serde(default, rename = "meadow")]
+    pub meadows: Vec<Meadow>,
+    #[serde(default, rename = "landmark")]
+    pub landmarks: Vec<Landmark>,
 }
 
 impl World {
-    /// The statistics of the terrain the robot is on.
+    /// The statistics of the world's default terrain (where no meadow says otherwise).
     pub fn ground_terrain(&self) -> &Terrain {
         // `load_str` rejects worlds whose ground is not in the table.
         &self.terrain[&self.ground]
+    }
+
+    /// The meadow containing `(x, y)`, if any.
+    pub fn meadow_at(&self, x: f64, y: f64) -> Option<&Meadow> {
+        self.meadows.iter().find(|m| contains(&m.outline, [x, y]))
+    }
+
+    /// The terrain under `(x, y)`: its meadow's, else the world's ground.
+    pub fn terrain_at(&self, x: f64, y: f64) -> &Terrain {
+        // `load_str` rejects meadows whose terrain is not in the table.
+        self.meadow_at(x, y).map_or(self.ground_terrain(), |m| &self.terrain[&m.terrain])
+    }
+
+    /// The innermost locale whose outline contains `(x, y)`.
+    pub fn locale_at(&self, x: f64, y: f64) -> Option<&Locale> {
+        self.locales
+            .iter()
+            .filter(|l| l.outline.len() >= 3 && contains(&l.outline, [x, y]))
+            .min_by(|a, b| signed_area(&a.outline).abs().total_cmp(&signed_area(&b.outline).abs()))
+    }
+
+    pub fn landmark(&self, name: &str) -> Option<&Landmark> {
+        self.landmarks.iter().find(|l| l.name == name)
     }
 }

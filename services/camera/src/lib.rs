@@ -77,22 +77,30 @@ impl Renderer {
         for (v, row) in out.chunks_exact_mut(row_bytes).enumerate() {
             let down = (v as f64 + 0.5 - cy) / self.focal_px; // image y of this row, down positive
             for (col, px) in self.columns.iter().zip(row.chunks_exact_mut(bpp)) {
-                let reflectance = match col.wall {
+                const WHITE: [f64; 3] = [1.0; 3];
+                let (reflectance, colour) = match col.wall {
                     Some((depth, wall, along)) => {
                         let z = cam.height_m - down * depth;
                         let w = &world.walls[wall];
                         if (0.0..=w.height_m).contains(&z) {
-                            w.reflectance_at(along, z)
+                            w.appearance_at(along, z)
                         } else if z < 0.0 {
-                            floor_at(world, [x, y], col, cam.height_m / down)
+                            (floor_at(world, [x, y], col, cam.height_m / down), WHITE)
                         } else {
-                            floor.ceiling_reflectance
+                            (floor.ceiling_reflectance, WHITE)
                         }
                     }
-                    None if down > 0.0 => floor_at(world, [x, y], col, cam.height_m / down),
-                    None => floor.ceiling_reflectance,
+                    None if down > 0.0 => (floor_at(world, [x, y], col, cam.height_m / down), WHITE),
+                    None => (floor.ceiling_reflectance, WHITE),
                 };
-                px.fill((cam.illumination * reflectance).round().clamp(0.0, 255.0) as u8);
+                let lit = cam.illumination * reflectance;
+                if bpp == 1 {
+                    px[0] = lit.round().clamp(0.0, 255.0) as u8;
+                } else {
+                    for (c, k) in px.iter_mut().zip(colour) {
+                        *c = (lit * k).round().clamp(0.0, 255.0) as u8;
+                    }
+                }
             }
         }
         Ok(())
@@ -137,19 +145,38 @@ mod tests {
         // The left edge column looks at the left wall (reflectance 0.70) near camera height, 7.7 m
         // along it, clear of its doors; its door at 4.0-4.9 m is darker (0.30) when seen from x = 2.
         assert_eq!(at(0, 240), lit(0.70));
+        // From x = 2 the column through the middle of the lab's doorway (x = 4.45 on the north
+        // wall) sees through the opening to the lab's east wall (reflectance 0.50).
         r.render(&w, [2.0, 0.0, 0.0], &mut img).expect("renders");
-        assert_eq!(img[240 * 640], lit(0.30));
+        let f = w.camera.focal_px;
+        let u = (320.0 - f * (1.0 / 2.45) - 0.5).round() as usize;
+        assert_eq!(img[240 * 640 + u], lit(0.50), "column {u}");
     }
 
     #[test]
-    fn rgb_replicates_gray_and_sizes_are_checked() {
+    fn colour_images_carry_the_regions_colours() {
+        let w = hallway();
+        let mut r = Renderer::new(&w, 640, 480, Encoding::Rgb8);
+        let mut img = vec![0u8; r.frame_bytes()];
+        // Facing the red sign (x 12.2-12.6, z 1.4-1.7 on the north wall) from 1 m in front of it.
+        r.render(&w, [12.4, 0.0, std::f64::consts::FRAC_PI_2], &mut img).expect("renders");
+        // The sign's centre, 0.35 m above the camera at 1 m: 0.35 x 554 px above the centre row.
+        let v = (240.0 - 0.35 * w.camera.focal_px).round() as usize;
+        let px = &img[(v * 640 + 320) * 3..(v * 640 + 320) * 3 + 3];
+        let lit = w.camera.illumination * 0.95;
+        assert_eq!(px, [(lit * 1.0).round() as u8, (lit * 0.35).round() as u8, (lit * 0.3).round() as u8]);
+    }
+
+    #[test]
+    fn uncoloured_faces_render_grey_in_rgb_and_sizes_are_checked() {
         let w = hallway();
         let mut mono = Renderer::new(&w, 64, 48, Encoding::Mono8);
         let mut rgb = Renderer::new(&w, 64, 48, Encoding::Rgb8);
         let mut a = vec![0u8; mono.frame_bytes()];
         let mut b = vec![0u8; rgb.frame_bytes()];
-        mono.render(&w, [1.0, 0.2, 0.1], &mut a).expect("renders");
-        rgb.render(&w, [1.0, 0.2, 0.1], &mut b).expect("renders");
+        // Looking back down the hall at the west end wall: no coloured region in view.
+        mono.render(&w, [1.0, 0.2, std::f64::consts::PI], &mut a).expect("renders");
+        rgb.render(&w, [1.0, 0.2, std::f64::consts::PI], &mut b).expect("renders");
         assert!(a.iter().zip(b.chunks_exact(3)).all(|(g, p)| p == [*g, *g, *g]));
         assert!(mono.render(&w, [0.0, 0.0, 0.0], &mut b).is_err());
         assert!(mono.render(&w, [f64::NAN, 0.0, 0.0], &mut a).is_err());

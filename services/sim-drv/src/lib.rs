@@ -76,7 +76,8 @@ impl SimDrv {
 
     /// Accepts or refuses a command; the answer goes back on the line at once.
     pub fn handle(&mut self, cmd: Command) -> Report {
-        let t = self.world.ground_terrain().clone();
+        // The terrain under the robot when the command starts (its meadow's, 002 §4).
+        let t = self.world.terrain_at(self.truth.x, self.truth.y).clone();
         let r = self.world.robot.clone();
         let (id, motion) = match cmd {
             Command::Stop { id } => {
@@ -146,7 +147,7 @@ impl SimDrv {
         self.time_ms += self.tick_ms;
         let dt_s = self.tick_ms as f64 / 1000.0;
         if let Some(m) = &mut self.motion {
-            let t = self.world.ground_terrain();
+            let t = self.world.terrain_at(self.truth.x, self.truth.y);
             let (truth, enc, finished) = motion::advance(m, t, self.truth, self.encoders, dt_s);
             self.truth = truth;
             self.encoders = enc;
