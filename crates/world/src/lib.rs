@@ -2,6 +2,7 @@
 //! statistics, the robot's sonar and drive, and the camera; loaded from TOML and ray cast.
 //!
 
+mod camera;
 mod load;
 mod model;
 mod raycast;

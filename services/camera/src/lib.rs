@@ -30,7 +30,7 @@ pub struct Renderer {
 impl Renderer {
     /// A renderer for `width_px x height_px`; the world's focal length scales with the width.
     pub fn new(world: &World, width_px: u32, height_px: u32, encoding: Encoding) -> Self {
-        let focal_px = world.camera.focal_px * f64::from(width_px) / f64::from(world.camera.width_px);
+        let focal_px = world.camera.focal_for(width_px);
         Self { width_px, height_px, encoding, focal_px, columns: vec![Column::default(); width_px as usize] }
     }
 

@@ -23,14 +23,34 @@ pub fn read_sensor(world: &World, truth: Pose, i: usize) -> u16 {
     let half = (r.sonar_beam_width_deg / 2.0).to_radians();
     let limit = r.sonar_specular_limit_deg.to_radians();
     let max_m = r.sonar_max_range_ft * FT;
-    let nearest = (0..RAYS_PER_BEAM)
+    let sampled = (0..RAYS_PER_BEAM)
         .filter_map(|k| {
             let a = axis - half + 2.0 * half * k as f64 / (RAYS_PER_BEAM - 1) as f64;
             world.cast_ray(origin, [a.cos(), a.sin()], max_m)
         })
         .filter(|h| h.incidence_rad <= limit)
-        .map(|h| h.distance_m)
-        .fold(f64::INFINITY, f64::min);
+        .map(|h| h.distance_m);
+    // A wall met head-on somewhere in the beam echoes from its nearest point: the foot of the
+    // perpendicular, when that lies inside the beam and nothing stands in front of it.
+    let perpendicular = world.walls.iter().enumerate().filter_map(|(i, w)| {
+        let e = [w.to[0] - w.from[0], w.to[1] - w.from[1]];
+        let len2 = e[0] * e[0] + e[1] * e[1];
+        let t = ((origin[0] - w.from[0]) * e[0] + (origin[1] - w.from[1]) * e[1]) / len2;
+        if !(0.0..=1.0).contains(&t) {
+            return None;
+        }
+        let foot = [w.from[0] + t * e[0] - origin[0], w.from[1] + t * e[1] - origin[1]];
+        let d = foot[0].hypot(foot[1]);
+        let off_axis = (foot[1].atan2(foot[0]) - axis + std::f64::consts::PI)
+            .rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        if d < 1e-9 || off_axis.abs() > half {
+            return None;
+        }
+        let hit = world.cast_ray(origin, [foot[0] / d, foot[1] / d], max_m)?;
+        (hit.wall == i).then_some(hit.distance_m)
+    });
+    let nearest = sampled.chain(perpendicular).fold(f64::INFINITY, f64::min);
     if nearest.is_finite() {
         ((nearest / FT) * 10.0).round().min(f64::from(SONAR_NO_ECHO - 1)) as u16
     } else {
@@ -56,9 +76,15 @@ mod tests {
         let w = hallway();
         // Robot on the centre line facing +x: sensor 6 (90 degrees) faces the left wall 1 m away.
         let truth = Pose { x: 2.0, y: 0.0, th: 0.0 };
-        let expected = (1.0 - w.robot.sonar_ring_radius_m) / FT * 10.0;
-        let got = f64::from(read_sensor(&w, truth, 6));
-        assert!((got - expected).abs() <= 1.0, "{got} vs {expected}");
+        let expected = ((1.0 - w.robot.sonar_ring_radius_m) / FT * 10.0).round() as u16;
+        assert_eq!(read_sensor(&w, truth, 6), expected, "exact to the tenth of a foot");
+        // Any angle inside the beam: the nearest echo is still the perpendicular one.
+        for th in [-0.25f64, -0.1, 0.07, 0.25] {
+            let turned = Pose { th, ..truth };
+            let d =
+                (1.0 - w.robot.sonar_ring_radius_m * (std::f64::consts::FRAC_PI_2 + th).sin()) / FT * 10.0;
+            assert_eq!(read_sensor(&w, turned, 6), d.round() as u16, "robot turned {th} rad");
+        }
     }
 
     #[test]
