@@ -1,6 +1,8 @@
 //! harvey-camera: renders the simulated world into loaned shared-memory frames, from the
 //! simulator's true pose (`sim/truth`), or from a fixed pose at a fixed rate (`--pose`).
 
+mod folder;
+
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -12,10 +14,14 @@ use harvey_msgs::{Encoding, FrameHeader, topics};
 use harvey_world::World;
 
 #[derive(Parser)]
-#[command(about = "Simulated camera rendering into shared memory")]
+#[command(about = "Simulated camera rendering into shared memory, or a folder of images played as frames")]
 struct Args {
+    /// World to render (required unless `--images` is given).
     #[arg(long)]
-    world: PathBuf,
+    world: Option<PathBuf>,
+    /// Play the PNG/JPEG images of this folder, in name order, at `--rate-hz`, looping.
+    #[arg(long, conflicts_with = "world")]
+    images: Option<PathBuf>,
     /// Image size; defaults to the world's calibrated camera.
     #[arg(long)]
     width: Option<u32>,
@@ -30,7 +36,8 @@ struct Args {
     /// Render from this fixed pose `x_m,y_m,heading_deg` instead of following `sim/truth`.
     #[arg(long, value_delimiter = ',')]
     pose: Option<Vec<f64>>,
-    /// With `--pose`: frames per second (wall clock), and how many to send (0: until stopped).
+    /// With `--pose` or `--images`: frames per second (wall clock), and how many to send (0:
+    /// until stopped).
     #[arg(long, default_value_t = 10.0)]
     rate_hz: f64,
     #[arg(long, default_value_t = 0)]
@@ -67,10 +74,49 @@ impl Camera {
     }
 }
 
+/// Plays a folder of images as frames until stopped or `--frames` are sent.
+fn play_folder(dir: &std::path::Path, args: &Args) -> anyhow::Result<()> {
+    let folder = folder::Folder::open(dir)?;
+    anyhow::ensure!(args.rate_hz > 0.0, "--rate-hz must be positive");
+    let bus = Bus::join("camera")?;
+    let publisher = bus.frame_publisher(topics::CAMERA_FRAME, folder.frame_bytes())?;
+    let waiter = Waiter::new()?;
+    let _tick = waiter.attach_interval(Duration::from_secs_f64(1.0 / args.rate_hz))?;
+    harvey_runtime::notify_ready()?;
+    tracing::info!(
+        images = folder.count(),
+        width = folder.width_px,
+        height = folder.height_px,
+        encoding = folder.encoding.ros_name(),
+        "playing {}",
+        dir.display()
+    );
+    let period_ns = (1e9 / args.rate_hz) as u64;
+    let mut seq = 0u64;
+    while waiter.wait(None)? != Wake::Shutdown && (args.frames == 0 || seq < args.frames) {
+        let header = FrameHeader::new(
+            seq + 1,
+            (seq + 1) * period_ns,
+            folder.width_px,
+            folder.height_px,
+            folder.encoding,
+        );
+        let mut frame = publisher.loan(header)?;
+        folder.decode_into(seq as usize, frame.pixels_mut())?;
+        frame.send()?;
+        seq += 1;
+    }
+    Ok(())
+}
+
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
-    let world = World::load(&args.world)?;
+    if let Some(dir) = &args.images {
+        return play_folder(dir, &args);
+    }
+    let world_path = args.world.as_ref().context("--world or --images is required")?;
+    let world = World::load(world_path)?;
     let encoding = Encoding::parse(&args.encoding)
         .with_context(|| format!("--encoding `{}`: expected mono8 or rgb8", args.encoding))?;
     let width = args.width.unwrap_or(world.camera.width_px);
