@@ -169,6 +169,22 @@ mod tests {
         let names: Vec<&str> = w.terrain.keys().map(String::as_str).collect();
         assert_eq!(names, ["concrete", "dry_grass", "gravel", "tile"]);
         assert!((w.terrain["dry_grass"].translational_sd_ft_per_ft - 0.0042).abs() < 1e-12);
+        // Each stretch of the path and the lawns carries its own terrain and look.
+        let at = |x, y| w.meadow_at(x, y).map(|m| m.terrain.as_str());
+        assert_eq!(
+            [at(2.0, 0.0), at(12.0, 0.0), at(24.0, 0.0), at(10.0, -5.0)],
+            [Some("tile"), Some("concrete"), Some("gravel"), Some("dry_grass")]
+        );
+        assert_eq!(w.floor_reflectance_at(24.0, 0.0), [0.40, 0.33]);
+        assert_eq!(w.locale_at(10.0, 3.0).map(|l| l.name.as_str()), Some("north-lawn"));
+        let kinds: Vec<_> = ["lamppost-2", "entrance", "path-south-edge"]
+            .iter()
+            .map(|n| w.landmark(n).map(|l| l.class))
+            .collect();
+        assert_eq!(
+            kinds,
+            [Some(crate::LandmarkClass::I), Some(crate::LandmarkClass::II), Some(crate::LandmarkClass::III)]
+        );
     }
 
     #[test]

@@ -166,6 +166,15 @@ impl World {
         self.meadow_at(x, y).map_or(self.ground_terrain(), |m| &self.terrain[&m.terrain])
     }
 
+    /// The reflectances of the floor's checker pattern at `(x, y)`.
+    pub fn floor_reflectance_at(&self, x: f64, y: f64) -> [f64; 2] {
+        self.meadows
+            .iter()
+            .filter_map(|m| m.floor_reflectance.map(|r| (m, r)))
+            .find(|(m, _)| contains(&m.outline, [x, y]))
+            .map_or(self.floor.reflectance, |(_, r)| r)
+    }
+
     /// The innermost locale whose outline contains `(x, y)`.
     pub fn locale_at(&self, x: f64, y: f64) -> Option<&Locale> {
         self.locales

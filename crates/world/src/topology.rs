@@ -76,6 +76,9 @@ pub struct Meadow {
     pub outline: Vec<[f64; 2]>,
     #[serde(default)]
     pub landmarks: Vec<String>,
+    /// The ground's look here: reflectances of its checker pattern (tiles, slabs, tufts);
+    /// the world's `[floor]` where not given.
+    pub floor_reflectance: Option<[f64; 2]>,
 }
 
 /// Whether `p` lies inside the polygon `poly` (even-odd rule; points on an edge may go either way).

@@ -113,7 +113,7 @@ fn floor_at(world: &World, origin: [f64; 2], col: &Column, depth_m: f64) -> f64 
     let p = [origin[0] + col.dir[0] * range, origin[1] + col.dir[1] * range];
     let t = world.floor.tile_m;
     let parity = ((p[0] / t).floor() as i64 + (p[1] / t).floor() as i64).rem_euclid(2) as usize;
-    world.floor.reflectance[parity]
+    world.floor_reflectance_at(p[0], p[1])[parity]
 }
 
 /// FNV-1a over a frame: a cheap fingerprint to compare frames across processes.
