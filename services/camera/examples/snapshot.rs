@@ -11,7 +11,8 @@ fn main() -> anyhow::Result<()> {
     let world = harvey_world::World::load(std::path::Path::new(&args[0]))?;
     let p: Vec<f64> = args[1].split(',').map(str::parse).collect::<Result<_, _>>()?;
     anyhow::ensure!(p.len() == 3, "pose is x_m,y_m,heading_deg");
-    let encoding = Encoding::parse(args.get(3).map_or("mono8", String::as_str)).ok_or_else(|| anyhow::anyhow!("encoding"))?;
+    let encoding = Encoding::parse(args.get(3).map_or("mono8", String::as_str))
+        .ok_or_else(|| anyhow::anyhow!("encoding"))?;
     let (w, h) = (world.camera.width_px, world.camera.height_px);
     let mut r = Renderer::new(&world, w, h, encoding);
     let mut px = vec![0u8; r.frame_bytes()];

@@ -22,6 +22,39 @@ pub enum Refusal {
     NotFinite { id: u32, field: &'static str },
     #[error("command {id}: {field} = {value:.3} is beyond the vehicle's limit of {limit}")]
     OutOfRange { id: u32, field: &'static str, value: f64, limit: f64 },
+    #[error("command {id}: a panic-stop is in force until t = {until_ns} ns")]
+    PanicStop { id: u32, until_ns: u64 },
+}
+
+/// The panic-stop's hold on the vehicle (001 §6.2): after an urgent stop, motion commands
+/// stamped within `hold_ns` of it are refused, so that no old or new motion command slips in
+/// while the sonar keeps reporting the obstacle (it re-sends the stop with every ring).
+#[derive(Debug)]
+pub struct PanicLatch {
+    hold_ns: u64,
+    until_ns: Option<u64>,
+}
+
+impl PanicLatch {
+    pub fn new(hold_ns: u64) -> Self {
+        Self { hold_ns, until_ns: None }
+    }
+
+    /// Lets a command through, or refuses it while a panic-stop holds.
+    pub fn admit(&mut self, cmd: &MotionCommand) -> Result<(), Refusal> {
+        let stop = cmd.kind() == Some(CommandKind::Stop);
+        if stop && cmd.urgent != 0 {
+            let until = cmd.header.stamp_ns.saturating_add(self.hold_ns);
+            self.until_ns = Some(self.until_ns.map_or(until, |u| u.max(until)));
+            return Ok(());
+        }
+        match self.until_ns {
+            Some(until_ns) if !stop && cmd.header.stamp_ns <= until_ns => {
+                Err(Refusal::PanicStop { id: cmd.command_id, until_ns })
+            }
+            _ => Ok(()),
+        }
+    }
 }
 
 /// Converts a bus command to the DRV's, or says why it must not be sent.
@@ -175,6 +208,29 @@ mod tests {
         let stop = MotionCommand { urgent: 1, ..cmd(CommandKind::Stop, 0.0, 0.0) };
         assert_eq!(prioritise(&[mv, stop, mv]), vec![stop]);
         assert_eq!(prioritise(&[mv, mv]).len(), 2);
+    }
+
+    #[test]
+    fn a_panic_stop_holds_motion_until_the_obstacle_is_gone() {
+        let mut latch = PanicLatch::new(200_000_000);
+        let at = |c: MotionCommand, stamp_ns| MotionCommand { header: Header::new(1, stamp_ns), ..c };
+        let mv = cmd(CommandKind::Move, 1.0, 0.0);
+        let panic = MotionCommand { urgent: 1, ..cmd(CommandKind::Stop, 0.0, 0.0) };
+        assert_eq!(latch.admit(&at(mv, 1_000)), Ok(()));
+        assert_eq!(latch.admit(&at(panic, 1_000_000_000)), Ok(()));
+        assert!(matches!(
+            latch.admit(&at(mv, 1_100_000_000)),
+            Err(Refusal::PanicStop { until_ns: 1_200_000_000, .. })
+        ));
+        // The sonar repeats the stop while the obstacle stays: the hold extends.
+        assert_eq!(latch.admit(&at(panic, 1_150_000_000)), Ok(()));
+        assert!(latch.admit(&at(mv, 1_300_000_000)).is_err());
+        assert_eq!(
+            latch.admit(&at(cmd(CommandKind::Stop, 0.0, 0.0), 1_300_000_000)),
+            Ok(()),
+            "plain stops always pass"
+        );
+        assert_eq!(latch.admit(&at(mv, 1_400_000_000)), Ok(()), "obstacle gone: motion resumes");
     }
 
     #[test]

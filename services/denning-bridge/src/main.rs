@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, FdSource, Waiter, Wake};
-use harvey_denning_bridge::{Bridge, Outgoing, prioritise, to_drv};
+use harvey_denning_bridge::{Bridge, Outgoing, PanicLatch, prioritise, to_drv};
 use harvey_drv_protocol::serial::{make_raw, read_available, write_frame};
 use harvey_drv_protocol::{Decoder, Line, encode};
 use harvey_msgs::topics;
@@ -19,6 +19,9 @@ struct Args {
     /// Serial device of the DRV (or the simulated DRV's pseudo-terminal link).
     #[arg(long)]
     device: PathBuf,
+    /// After a panic-stop, refuse motion commands for this long (simulated or sensor time).
+    #[arg(long, default_value_t = 200)]
+    panic_hold_ms: u64,
 }
 
 fn main() -> anyhow::Result<()> {
@@ -44,6 +47,7 @@ fn main() -> anyhow::Result<()> {
     tracing::info!(device = %args.device.display(), "bridge up");
 
     let mut bridge = Bridge::default();
+    let mut latch = PanicLatch::new(args.panic_hold_ms * 1_000_000);
     let mut decoder = Decoder::new();
     let mut buf = Vec::new();
     let mut batch = Vec::new();
@@ -54,7 +58,7 @@ fn main() -> anyhow::Result<()> {
         batch.clear();
         commands.drain(|c| batch.push(*c))?;
         for cmd in prioritise(&batch) {
-            match to_drv(&cmd) {
+            match latch.admit(&cmd).and_then(|()| to_drv(&cmd)) {
                 Ok(drv) => {
                     if !write_frame(&mut port, encode(&Line::Command(drv)).as_bytes())? {
                         tracing::error!(?drv, "serial line full: command not sent");
