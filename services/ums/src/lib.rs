@@ -3,6 +3,10 @@
 //! rectangle aligned with the heading plus a heading wedge. The paper's convex-hull growth and the
 //! landmark reductions come with the UMS issue.
 
+pub mod geometry;
+pub mod map;
+pub mod reduction;
+
 use harvey_msgs::{Header, MAX_POLYGON_VERTICES, Odometry, Pose2, UncertaintyMap};
 use harvey_world::Terrain;
 

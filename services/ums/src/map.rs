@@ -1,0 +1,141 @@
+//! The spatial uncertainty map (002 §3.1) and its growth (§3.3): a convex polygon of possible
+//! positions with a most likely centre, and a heading wedge with clockwise and counter-clockwise
+//! limits, grown by each turn-and-run with the terrain's Table 3 statistics at `k` sigma.
+
+use harvey_world::Terrain;
+
+use crate::geometry::{self, Pt};
+
+const FT: f64 = 0.3048;
+/// Most vertices the published polygon may have (`harvey_msgs::MAX_POLYGON_VERTICES`).
+pub const MAX_VERTICES: usize = harvey_msgs::MAX_POLYGON_VERTICES;
+
+/// Position and heading uncertainty.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Map {
+    /// Convex, counter-clockwise, world frame; a single point when the pose is known exactly.
+    pub polygon: Vec<Pt>,
+    pub centre: Pt,
+    /// Most likely heading.
+    pub heading_rad: f64,
+    /// How far the true heading may lie clockwise / counter-clockwise of `heading_rad`.
+    pub cw_rad: f64,
+    pub ccw_rad: f64,
+}
+
+impl Map {
+    /// A map that knows the pose exactly (a point and a zero-width wedge).
+    pub fn exact(x: f64, y: f64, heading_rad: f64) -> Self {
+        Self { polygon: vec![[x, y]], centre: [x, y], heading_rad, cw_rad: 0.0, ccw_rad: 0.0 }
+    }
+
+    /// A map starting from a known region (002 §3.3: the start need not be a point).
+    pub fn region(polygon: &[Pt], heading_rad: f64, cw_rad: f64, ccw_rad: f64) -> Self {
+        let polygon = geometry::hull(polygon);
+        let n = polygon.len().max(1) as f64;
+        let centre = polygon.iter().fold([0.0, 0.0], |c, p| [c[0] + p[0] / n, c[1] + p[1] / n]);
+        Self { polygon, centre, heading_rad, cw_rad, ccw_rad }
+    }
+
+    pub fn area_m2(&self) -> f64 {
+        geometry::area(&self.polygon)
+    }
+
+    /// The heading interval `[lo, hi]` (radians, `lo <= hi`).
+    pub fn wedge(&self) -> [f64; 2] {
+        [self.heading_rad - self.cw_rad, self.heading_rad + self.ccw_rad]
+    }
+
+    /// Whether a pose lies inside the map: position in the polygon, heading in the wedge.
+    pub fn contains(&self, p: Pt, heading_rad: f64, tol: f64) -> bool {
+        let d = wrap(heading_rad - self.heading_rad);
+        geometry::contains(&self.polygon, p, tol) && d >= -self.cw_rad - 1e-12 && d <= self.ccw_rad + 1e-12
+    }
+}
+
+/// An angle in (-π, π].
+pub fn wrap(a: f64) -> f64 {
+    let w = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    if w <= -std::f64::consts::PI { w + std::f64::consts::TAU } else { w }
+}
+
+/// The growth model: Table 3 statistics of the terrain and the probability in sigmas.
+#[derive(Debug, Clone)]
+pub struct Growth<'t> {
+    pub terrain: &'t Terrain,
+    pub sigmas: f64,
+}
+
+impl Growth<'_> {
+    /// A turn of `angle_rad` commanded (counter-clockwise positive), 002 §3.3 and Fig. 71: the
+    /// centre turns by the mean, the limits open by `k` deviations on the side the robot may
+    /// fall short, and on the other side no further than commanded; skitter moves every point.
+    pub fn turn(&self, map: &mut Map, angle_rad: f64) {
+        let t = self.terrain;
+        let deg = angle_rad.abs().to_degrees();
+        if deg == 0.0 {
+            return;
+        }
+        let mean_loss = t.rotational_loss_deg_per_deg * deg;
+        let spread = self.sigmas * t.rotational_sd_deg_per_deg * deg;
+        map.heading_rad += angle_rad.signum() * (deg - mean_loss).to_radians();
+        // Overshooting past the commanded angle is impossible: that side opens by at most the
+        // mean loss; the short side by the full spread.
+        let (short, long) = (spread.to_radians(), spread.min(mean_loss).to_radians());
+        if angle_rad > 0.0 {
+            map.cw_rad += short;
+            map.ccw_rad += long;
+        } else {
+            map.ccw_rad += short;
+            map.cw_rad += long;
+        }
+        let skitter_m = (t.skitter_ft_per_deg + self.sigmas * t.skitter_sd_ft_per_deg) * deg * FT;
+        let pts: Vec<Pt> = map
+            .polygon
+            .iter()
+            .flat_map(|v| {
+                [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+                    .map(|[a, b]| [v[0] + a * skitter_m, v[1] + b * skitter_m])
+            })
+            .collect();
+        map.polygon = geometry::limit_vertices(geometry::hull(&pts), MAX_VERTICES);
+    }
+
+    /// A run of `distance_m` commanded along the heading (`first` when it starts a MOVE, which
+    /// adds the inertial loss once), 002 §3.3 and Fig. 70: each vertex sweeps the sector of
+    /// distances and headings it may have travelled, enclosed in a polygon, then the hull.
+    pub fn run(&self, map: &mut Map, distance_m: f64, first: bool) {
+        let t = self.terrain;
+        let ft = distance_m.abs() / FT;
+        if ft == 0.0 && !first {
+            return;
+        }
+        let inertial = if first { t.inertial_loss_ft } else { 0.0 };
+        let mean_ft = ft - t.translational_loss_ft_per_ft * ft - inertial;
+        let spread_ft = self.sigmas * t.translational_sd_ft_per_ft * ft;
+        let s_min = (mean_ft - spread_ft).max(0.0) * FT;
+        let s_max = (mean_ft + spread_ft).min(ft).max(0.0) * FT;
+        // Drift, treated symmetrically (002 §3.2: "by overestimation ... a fixed factor").
+        let drift = ((t.drift_deg_per_ft + self.sigmas * t.drift_sd_deg_per_ft) * ft).to_radians();
+        let sign = if distance_m < 0.0 { std::f64::consts::PI } else { 0.0 };
+        let [lo, hi] = map.wedge();
+        let (a0, a1) = (lo - drift / 2.0 + sign, hi + drift / 2.0 + sign);
+        let mut pts = Vec::with_capacity(map.polygon.len() * 8);
+        for v in &map.polygon {
+            pts.push([v[0] + s_min * a0.cos(), v[1] + s_min * a0.sin()]);
+            pts.push([v[0] + s_min * a1.cos(), v[1] + s_min * a1.sin()]);
+            pts.extend(geometry::arc_enclosure(*v, s_max, a0, a1));
+        }
+        map.polygon = geometry::limit_vertices(geometry::hull(&pts), MAX_VERTICES);
+        let s_mean = mean_ft.max(0.0) * FT;
+        map.centre = [
+            map.centre[0] + s_mean * (map.heading_rad + sign).cos(),
+            map.centre[1] + s_mean * (map.heading_rad + sign).sin(),
+        ];
+        if !geometry::contains(&map.polygon, map.centre, 1e-9) {
+            map.centre = geometry::nearest_point(&map.polygon, map.centre);
+        }
+        map.cw_rad += drift;
+        map.ccw_rad += drift;
+    }
+}
