@@ -3,6 +3,7 @@
 //! rectangle aligned with the heading plus a heading wedge. The paper's convex-hull growth and the
 //! landmark reductions come with the UMS issue.
 
+pub mod expecter;
 pub mod geometry;
 pub mod map;
 pub mod reduction;

@@ -1,0 +1,108 @@
+//! The Expecter (002 §5.1): the image window in which a landmark must appear, given the map —
+//! the worst case over the polygon's vertices and the wedge's limits through the camera
+//! calibration — widened for the perceptual strategy that will look in it. For comparison, the
+//! window a disk model of the same uncertainty gives (002 Fig. 68–69).
+
+use harvey_world::{Camera, Landmark, LandmarkClass};
+
+use crate::geometry::Pt;
+use crate::map::{Map, wrap};
+
+/// An image window in pixels, `[u0, u1) x [v0, v1)`, inside the image.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Window {
+    pub u0: f64,
+    pub v0: f64,
+    pub u1: f64,
+    pub v1: f64,
+}
+
+impl Window {
+    pub fn area_px(&self) -> f64 {
+        (self.u1 - self.u0).max(0.0) * (self.v1 - self.v0).max(0.0)
+    }
+
+    pub fn contains(&self, p: [f64; 2]) -> bool {
+        (self.u0..=self.u1).contains(&p[0]) && (self.v0..=self.v1).contains(&p[1])
+    }
+}
+
+/// The image and the camera that sees it.
+#[derive(Debug, Clone, Copy)]
+pub struct View<'c> {
+    pub camera: &'c Camera,
+    pub width_px: u32,
+    pub height_px: u32,
+}
+
+/// World points that stand for a landmark in the image: a vertical line's foot and top, a
+/// point, or points along a ground line within `reach_m` of `near`.
+pub fn feature_points(l: &Landmark, near: Pt, reach_m: f64) -> Vec<[f64; 3]> {
+    let p = l.position_m;
+    match (l.class, l.to_m) {
+        (LandmarkClass::I, _) => vec![p, [p[0], p[1], p[2] + l.height_m]],
+        (LandmarkClass::III, Some(q)) => {
+            let n = 16;
+            (0..=n)
+                .map(|k| k as f64 / n as f64)
+                .map(|t| [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1]), 0.0])
+                .filter(|x| (x[0] - near[0]).hypot(x[1] - near[1]) <= reach_m)
+                .collect()
+        }
+        _ => vec![p],
+    }
+}
+
+/// The bounding box of `points` seen from every `(position, heading)` in `poses`, clipped to
+/// the image and widened by `margin_px`; `None` if nothing projects into view.
+fn bounds(view: View<'_>, poses: &[(Pt, f64)], points: &[[f64; 3]], margin_px: f64) -> Option<Window> {
+    let (w, h) = (f64::from(view.width_px), f64::from(view.height_px));
+    let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    for (p, th) in poses {
+        for x in points {
+            if let Some([u, v]) = view.camera.project(view.width_px, view.height_px, [p[0], p[1], *th], *x) {
+                b = [b[0].min(u), b[1].min(v), b[2].max(u), b[3].max(v)];
+            }
+        }
+    }
+    let win = Window {
+        u0: (b[0] - margin_px).max(0.0),
+        v0: (b[1] - margin_px).max(0.0),
+        u1: (b[2] + margin_px).min(w),
+        v1: (b[3] + margin_px).min(h),
+    };
+    (b[0].is_finite() && win.u0 < win.u1 && win.v0 < win.v1).then_some(win)
+}
+
+/// Headings to try from `p`: the wedge's limits, and the heading facing the landmark when the
+/// wedge holds it (where its depth, and so its image row, peaks).
+fn headings(map: &Map, p: Pt, target: [f64; 3]) -> Vec<f64> {
+    let [lo, hi] = map.wedge();
+    let facing = map.heading_rad + wrap((target[1] - p[1]).atan2(target[0] - p[0]) - map.heading_rad);
+    let mut hs = vec![lo, hi];
+    if (lo..=hi).contains(&facing) {
+        hs.push(facing);
+    }
+    hs
+}
+
+/// The Expecter's window for landmark `l` under `map`.
+pub fn window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option<Window> {
+    let points = feature_points(l, map.centre, l.activation_range_m);
+    let poses: Vec<(Pt, f64)> = map
+        .polygon
+        .iter()
+        .flat_map(|p| points.iter().flat_map(|x| headings(map, *p, *x)).map(move |th| (*p, th)))
+        .collect();
+    bounds(view, &poses, &points, margin_px)
+}
+
+/// The window a disk of the same uncertainty (centred on the map's centre, reaching its
+/// farthest vertex) would give: the model 002 §3.1 argues against.
+pub fn disk_window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option<Window> {
+    let c = map.centre;
+    let r = map.polygon.iter().map(|p| (p[0] - c[0]).hypot(p[1] - c[1])).fold(0.0, f64::max);
+    let disk: Vec<Pt> = (0..72).map(|k| k as f64 * std::f64::consts::TAU / 72.0).map(|a| [c[0] + r * a.cos(), c[1] + r * a.sin()]).collect();
+    let as_map = Map { polygon: disk, ..map.clone() };
+    window(&as_map, view, l, margin_px)
+}
