@@ -78,7 +78,8 @@ fn the_default_mission_runs_records_and_cleans_up() {
             _ => {}
         }
     }
-    for t in topics::ALL {
+    // Landmark sightings come from the vision issue's recognisers; nothing publishes them yet.
+    for t in topics::ALL.iter().filter(|t| **t != topics::VISION_SIGHTINGS.name) {
         assert!(counts.get(*t).copied().unwrap_or(0) > 0, "no message on {t}: {counts:?}");
     }
     assert!(counts["camera/frame"] >= 50, "{counts:?}");

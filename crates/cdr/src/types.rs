@@ -2,8 +2,8 @@
 //! A `Header` is written as a `std_msgs/Header` followed by `uint64 seq`.
 
 use harvey_msgs::{
-    Detections, EncodersRaw, Feature, FrameHeader, Header, MissionStatus, MotionCommand, Odometry, Pose2,
-    SonarRaw, SonarRing, TruePose, UncertaintyMap,
+    Detections, EncodersRaw, Expectation, Feature, FrameHeader, Header, LandmarkSighting, MissionStatus,
+    MotionCommand, Odometry, Pose2, SonarRaw, SonarRing, TruePose, UncertaintyMap,
 };
 
 use crate::codec::{Cdr, CdrError, CdrReader, CdrWriter};
@@ -102,7 +102,9 @@ ros2_struct!(SonarRing, SONAR_RING = ("harvey_msgs/SonarRing", with_header!("flo
 ros2_struct!(EncodersRaw, ENCODERS_RAW = ("harvey_msgs/EncodersRaw", with_header!("float64 x_m\nfloat64 y_m\nfloat64 heading_rad\nuint32 moving\nuint32 command_id\n"), [&STD_HEADER]) { header, x_m, y_m, heading_rad, moving, command_id });
 ros2_struct!(Odometry, ODOMETRY = ("harvey_msgs/Odometry", with_header!("harvey_msgs/Pose2 world_from_robot\nfloat64 travelled_m\nfloat64 turned_rad\nharvey_msgs/MotionCommand command\nuint32 moving\nuint32 command_accepted\n"), [&STD_HEADER, &POSE2, &MOTION_COMMAND]) { header, world_from_robot, travelled_m, turned_rad, command, moving, command_accepted });
 ros2_struct!(Detections, DETECTIONS = ("harvey_msgs/Detections", with_header!("uint64 frame_seq\nuint32 algorithm\nuint32 count\nfloat32 confidence\nuint32 reserved\nharvey_msgs/Feature[32] features\n"), [&STD_HEADER, &FEATURE]) { header, frame_seq, algorithm, count, confidence, reserved, features });
-ros2_struct!(UncertaintyMap, UNCERTAINTY_MAP = ("harvey_msgs/UncertaintyMap", with_header!("harvey_msgs/Pose2 centre\nuint32 vertex_count\nuint32 reserved\nfloat64[64] vertices_m # x0 y0 x1 y1 ...\nfloat64 heading_cw_rad\nfloat64 heading_ccw_rad\nfloat64 area_m2\n"), [&STD_HEADER, &POSE2]) { header, centre, vertex_count, reserved, vertices_m, heading_cw_rad, heading_ccw_rad, area_m2 });
+ros2_struct!(UncertaintyMap, UNCERTAINTY_MAP = ("harvey_msgs/UncertaintyMap", with_header!("harvey_msgs/Pose2 centre\nuint32 vertex_count\nuint32 lost\nfloat64[64] vertices_m # x0 y0 x1 y1 ...\nfloat64 heading_cw_rad\nfloat64 heading_ccw_rad\nfloat64 area_m2\nuint32 missed_landmarks\nuint32 reserved\n"), [&STD_HEADER, &POSE2]) { header, centre, vertex_count, lost, vertices_m, heading_cw_rad, heading_ccw_rad, area_m2, missed_landmarks, reserved });
+ros2_struct!(LandmarkSighting, LANDMARK_SIGHTING = ("harvey_msgs/LandmarkSighting", with_header!("uint64 frame_seq\nuint32 landmark_index\nuint32 kind # 0 not found, 1 bearing, 2 bearing+range, 3 ground line\nfloat64 a\nfloat64 a_sd\nfloat64 b\nfloat64 b_sd\n"), [&STD_HEADER]) { header, frame_seq, landmark_index, kind, a, a_sd, b, b_sd });
+ros2_struct!(Expectation, EXPECTATION = ("harvey_msgs/Expectation", with_header!("uint32 landmark_index\nuint32 class\nfloat32[4] window_px # u0 v0 u1 v1\nuint32 width_px\nuint32 height_px\n"), [&STD_HEADER]) { header, landmark_index, class, window_px, width_px, height_px });
 ros2_struct!(MissionStatus, MISSION_STATUS = ("harvey_msgs/MissionStatus", with_header!("uint32 state # 0 running, 1 succeeded, 2 failed\nuint32 step\nuint32 step_count\nuint32 reserved\nharvey_msgs/Pose2 estimated\nharvey_msgs/Pose2 goal\nuint64 sonar_rings_seen\nuint64 detections_seen\nuint64 maps_seen\n"), [&STD_HEADER, &POSE2]) { header, state, step, step_count, reserved, estimated, goal, sonar_rings_seen, detections_seen, maps_seen });
 
 impl Cdr for MotionCommand {
@@ -175,6 +177,24 @@ mod tests {
             vertex_count: 4,
             area_m2: 0.5,
             ..Default::default()
+        });
+        round_trip(LandmarkSighting {
+            header: h,
+            frame_seq: 3,
+            landmark_index: 2,
+            kind: 2,
+            a: 0.1,
+            a_sd: 0.01,
+            b: 4.0,
+            b_sd: 0.1,
+        });
+        round_trip(Expectation {
+            header: h,
+            landmark_index: 1,
+            class: 1,
+            window_px: [1.0, 2.0, 30.0, 40.0],
+            width_px: 640,
+            height_px: 480,
         });
         round_trip(MissionStatus { header: h, state: 1, goal: pose, maps_seen: 3, ..Default::default() });
     }

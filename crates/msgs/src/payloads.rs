@@ -190,13 +190,79 @@ pub struct UncertaintyMap {
     pub header: Header,
     pub centre: Pose2,
     pub vertex_count: u32,
-    pub reserved: u32,
+    /// 1 when the UMS considers the robot lost (area over its limit or landmarks missed).
+    pub lost: u32,
     pub vertices_m: [[f64; 2]; MAX_POLYGON_VERTICES],
+    /// How far the true heading may lie clockwise / counter-clockwise of `centre.heading_rad`.
     pub heading_cw_rad: f64,
     pub heading_ccw_rad: f64,
     pub area_m2: f64,
+    /// Predicted landmarks missed in a row.
+    pub missed_landmarks: u32,
+    pub reserved: u32,
 }
 message!(UncertaintyMap);
+
+/// What a landmark sighting measured (`LandmarkSighting::kind`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum SightingKind {
+    /// The landmark was looked for in its window and not found.
+    NotFound = 0,
+    /// Class I: `a` is the bearing (rad, counter-clockwise from the heading).
+    Bearing = 1,
+    /// Class II: `a` bearing (rad), `b` horizontal range (m).
+    BearingRange = 2,
+    /// Class III: `a` the robot's heading relative to the line (rad), `b` its signed offset
+    /// from the line (m, left positive).
+    GroundLine = 3,
+}
+
+impl SightingKind {
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        match raw {
+            0 => Some(Self::NotFound),
+            1 => Some(Self::Bearing),
+            2 => Some(Self::BearingRange),
+            3 => Some(Self::GroundLine),
+            _ => None,
+        }
+    }
+}
+
+/// A landmark recognised (or not) in a frame (`vision/sightings`), in the robot frame.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/LandmarkSighting")]
+pub struct LandmarkSighting {
+    pub header: Header,
+    pub frame_seq: u64,
+    /// Index of the landmark in the world file's `[[landmark]]` list.
+    pub landmark_index: u32,
+    /// [`SightingKind`] as its discriminant.
+    pub kind: u32,
+    pub a: f64,
+    pub a_sd: f64,
+    pub b: f64,
+    pub b_sd: f64,
+}
+message!(LandmarkSighting);
+
+/// The Expecter's window for a landmark (`ums/expectations`): where to look in the next frames.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/Expectation")]
+pub struct Expectation {
+    pub header: Header,
+    pub landmark_index: u32,
+    /// Landmark class, 1..=3.
+    pub class: u32,
+    /// `[u0, v0, u1, v1]` in pixels of a `width_px x height_px` image.
+    pub window_px: [f32; 4],
+    pub width_px: u32,
+    pub height_px: u32,
+}
+message!(Expectation);
 
 /// Mission states published by the executive.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

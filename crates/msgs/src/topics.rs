@@ -3,8 +3,8 @@
 use core::marker::PhantomData;
 
 use crate::{
-    Detections, EncodersRaw, MissionStatus, MotionCommand, Odometry, SonarRaw, SonarRing, TruePose,
-    UncertaintyMap,
+    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, SonarRaw,
+    SonarRing, TruePose, UncertaintyMap,
 };
 
 /// Queue sizing of a topic. Every process opening the topic uses the same numbers, so the
@@ -66,6 +66,8 @@ pub const SONAR_RING: Topic<SonarRing> = Topic::new("sonar/ring", Qos::STATE);
 pub const ODOMETRY: Topic<Odometry> = Topic::new("odometry", Qos::STATE);
 pub const VISION_DETECTIONS: Topic<Detections> = Topic::new("vision/detections", Qos::STATE);
 pub const UMS_MAP: Topic<UncertaintyMap> = Topic::new("ums/map", Qos::STATE);
+pub const VISION_SIGHTINGS: Topic<LandmarkSighting> = Topic::new("vision/sightings", Qos::STATE);
+pub const UMS_EXPECTATIONS: Topic<Expectation> = Topic::new("ums/expectations", Qos::STATE);
 pub const EXECUTIVE_STATUS: Topic<MissionStatus> = Topic::new("executive/status", Qos::STATE);
 pub const CAMERA_FRAME: FrameTopic = FrameTopic { name: "camera/frame", qos: Qos::FRAMES };
 
@@ -79,6 +81,8 @@ pub const ALL: &[&str] = &[
     ODOMETRY.name,
     VISION_DETECTIONS.name,
     UMS_MAP.name,
+    VISION_SIGHTINGS.name,
+    UMS_EXPECTATIONS.name,
     EXECUTIVE_STATUS.name,
     CAMERA_FRAME.name,
 ];

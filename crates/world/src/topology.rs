@@ -60,6 +60,9 @@ pub struct Landmark {
     /// Class I: the line's length upwards from its foot.
     #[serde(default)]
     pub height_m: f64,
+    /// How well the world model knows where the landmark is (standard deviation, metres).
+    #[serde(default)]
+    pub position_sd_m: f64,
     /// Seen only within this distance of the robot.
     pub activation_range_m: f64,
     /// Seen only while the robot's heading lies within this interval (degrees, counter-clockwise).
@@ -131,6 +134,7 @@ mod tests {
             position_m: [10.0, 0.0, 1.5],
             to_m: None,
             height_m: 0.0,
+            position_sd_m: 0.0,
             activation_range_m: 5.0,
             view_headings_deg: [-45.0, 45.0],
             strategy: Strategy::Correlation,

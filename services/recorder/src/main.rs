@@ -88,6 +88,8 @@ fn main() -> anyhow::Result<()> {
         tap(&bus, &mut rec, topics::ODOMETRY)?,
         tap(&bus, &mut rec, topics::VISION_DETECTIONS)?,
         tap(&bus, &mut rec, topics::UMS_MAP)?,
+        tap(&bus, &mut rec, topics::VISION_SIGHTINGS)?,
+        tap(&bus, &mut rec, topics::UMS_EXPECTATIONS)?,
         tap(&bus, &mut rec, topics::EXECUTIVE_STATUS)?,
         Box::new(FrameTap { sub: bus.frame_subscriber(topics::CAMERA_FRAME)?, channel: frame_channel }),
     ];

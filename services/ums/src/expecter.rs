@@ -102,7 +102,10 @@ pub fn window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option
 pub fn disk_window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option<Window> {
     let c = map.centre;
     let r = map.polygon.iter().map(|p| (p[0] - c[0]).hypot(p[1] - c[1])).fold(0.0, f64::max);
-    let disk: Vec<Pt> = (0..72).map(|k| k as f64 * std::f64::consts::TAU / 72.0).map(|a| [c[0] + r * a.cos(), c[1] + r * a.sin()]).collect();
+    let disk: Vec<Pt> = (0..72)
+        .map(|k| k as f64 * std::f64::consts::TAU / 72.0)
+        .map(|a| [c[0] + r * a.cos(), c[1] + r * a.sin()])
+        .collect();
     let as_map = Map { polygon: disk, ..map.clone() };
     window(&as_map, view, l, margin_px)
 }

@@ -195,7 +195,7 @@ mod tests {
     #[test]
     fn limiting_vertices_only_grows() {
         let circle: Vec<Pt> = (0..100)
-            .map(|k| (k as f64 * std::f64::consts::TAU / 100.0))
+            .map(|k| k as f64 * std::f64::consts::TAU / 100.0)
             .map(|a| [a.cos(), a.sin()])
             .collect();
         let h = hull(&circle);

@@ -1,108 +1,286 @@
-//! The UMS's logic, first version: the position uncertainty grows with the distance and
-//! rotation reported by odometry, at 3 sigma of the terrain's Table 3 statistics (002 §3.2), as a
-//! rectangle aligned with the heading plus a heading wedge. The paper's convex-hull growth and the
-//! landmark reductions come with the UMS issue.
+//! The uncertainty management subsystem (002 ch. VII) as a state machine: odometry grows the map
+//! turn by turn and run by run (§3.3), landmark sightings slice it (§3.4) at their own time
+//! stamps — a late sighting is applied to the map as it was then and the growth since replayed —
+//! the Expecter publishes where each active landmark must appear (§4, §5.1), and the map reports
+//! "lost" when it grows too large or predicted landmarks go missing.
 
 pub mod expecter;
 pub mod geometry;
 pub mod map;
 pub mod reduction;
 
-use harvey_msgs::{Header, MAX_POLYGON_VERTICES, Odometry, Pose2, UncertaintyMap};
-use harvey_world::Terrain;
+use std::collections::VecDeque;
 
-const FT: f64 = 0.3048;
-/// Sigmas of the map's probability (002 §3.1 uses 2 or 3).
-const SIGMAS: f64 = 3.0;
+use harvey_msgs::{
+    Expectation, Header, LandmarkSighting, MAX_POLYGON_VERTICES, Odometry, Pose2, SightingKind,
+    UncertaintyMap,
+};
+use harvey_world::{LandmarkClass, Strategy, World};
 
-/// Accumulated motion since the map was last a point.
-#[derive(Debug)]
+use expecter::View;
+use map::{Growth, Map};
+use reduction::{Known, Observation};
+
+/// How the UMS works; the defaults follow 002 §3.1 (3 sigma).
+#[derive(Debug, Clone)]
+pub struct Config {
+    pub sigmas: f64,
+    /// Above this area the robot is lost.
+    pub lost_area_m2: f64,
+    /// This many predicted landmarks missed in a row and the robot is lost.
+    pub lost_after_misses: u32,
+    /// How long a sighting may lag the odometry and still be applied at its own stamp.
+    pub history_ns: u64,
+    pub image_px: (u32, u32),
+}
+
+/// Pixels added around a window for the strategy that searches it: a correlation template's
+/// half-size, a line finder's gradient support, a region's growth.
+pub fn margin_px(s: Strategy) -> f64 {
+    match s {
+        Strategy::LineFinder => 4.0,
+        Strategy::RegionSegmenter | Strategy::Hough => 6.0,
+        Strategy::Correlation => 8.0,
+    }
+}
+
+/// One growth step taken from odometry.
+#[derive(Debug, Clone, Copy)]
+struct Step {
+    turn_rad: f64,
+    run_m: f64,
+    first_run: bool,
+}
+
+/// What the UMS publishes.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Output {
+    Map(Box<UncertaintyMap>),
+    Expectation(Expectation),
+}
+
+/// The UMS's state.
 pub struct Ums {
-    terrain: Terrain,
-    last: Option<Pose2>,
+    world: World,
+    config: Config,
+    map: Map,
+    /// (stamp, map after the step, step): what a late sighting rewinds to.
+    history: VecDeque<(u64, Map, Step)>,
+    pending: Vec<LandmarkSighting>,
+    command_id: u32,
     travelled_m: f64,
     turned_rad: f64,
+    run_started: bool,
+    last_stamp_ns: u64,
+    missed: u32,
     seq: u64,
 }
 
 impl Ums {
-    pub fn new(terrain: Terrain) -> Self {
-        Self { terrain, last: None, travelled_m: 0.0, turned_rad: 0.0, seq: 0 }
+    /// Starts with the pose known exactly at the world's start.
+    pub fn new(world: World, config: Config) -> Self {
+        let s = world.start;
+        let map = Map::exact(s.x_m, s.y_m, s.heading_deg.to_radians());
+        Self {
+            world,
+            config,
+            map,
+            history: VecDeque::new(),
+            pending: Vec::new(),
+            command_id: 0,
+            travelled_m: 0.0,
+            turned_rad: 0.0,
+            run_started: false,
+            last_stamp_ns: 0,
+            missed: 0,
+            seq: 0,
+        }
     }
 
-    /// Grows the map by the motion since the previous odometry; returns the map to publish.
-    pub fn on_odometry(&mut self, o: &Odometry) -> Result<UncertaintyMap, String> {
-        let p = o.world_from_robot;
-        if !(p.x_m.is_finite() && p.y_m.is_finite() && p.heading_rad.is_finite()) {
-            return Err("odometry holds a non-finite pose".into());
+    pub fn map(&self) -> &Map {
+        &self.map
+    }
+
+    fn grow(&self, map: &mut Map, step: Step) {
+        let terrain = self.world.terrain_at(map.centre[0], map.centre[1]);
+        let g = Growth { terrain, sigmas: self.config.sigmas };
+        g.turn(map, step.turn_rad);
+        if step.run_m != 0.0 || step.first_run {
+            g.run(map, step.run_m, step.first_run);
         }
-        if let Some(q) = self.last {
-            self.travelled_m += (p.x_m - q.x_m).hypot(p.y_m - q.y_m);
-            let d = (p.heading_rad - q.heading_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-                - std::f64::consts::PI;
-            self.turned_rad += d.abs();
+    }
+
+    /// One odometry message: grow by the motion since the last, apply sightings now due.
+    pub fn on_odometry(&mut self, o: &Odometry) -> Result<Vec<Output>, String> {
+        if o.header.stamp_ns < self.last_stamp_ns {
+            return Err(format!(
+                "odometry at {} ns is older than the last ({} ns)",
+                o.header.stamp_ns, self.last_stamp_ns
+            ));
         }
-        self.last = Some(p);
-        let t = &self.terrain;
-        let ft = self.travelled_m / FT;
-        let deg = self.turned_rad.to_degrees();
-        let along_m =
-            SIGMAS * t.translational_sd_ft_per_ft * ft * FT + t.inertial_loss_ft * FT * f64::from(ft > 0.0);
-        let drift_rad = (SIGMAS * t.drift_sd_deg_per_ft * ft).to_radians();
-        let cross_m =
-            self.travelled_m * (drift_rad / 2.0).sin() + SIGMAS * t.skitter_sd_ft_per_deg * deg * FT;
-        let wedge_rad = drift_rad + (SIGMAS * t.rotational_sd_deg_per_deg * deg).to_radians();
-        let (c, s) = (p.heading_rad.cos(), p.heading_rad.sin());
-        let mut vertices_m = [[0.0; 2]; MAX_POLYGON_VERTICES];
-        for (v, (a, b)) in vertices_m.iter_mut().zip([(1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)]) {
-            let (dx, dy) = (a * along_m, b * cross_m);
-            *v = [p.x_m + dx * c - dy * s, p.y_m + dx * s + dy * c];
+        if !(o.travelled_m.is_finite() && o.turned_rad.is_finite() && o.command.distance_m.is_finite()) {
+            return Err("odometry holds a non-finite number".into());
         }
+        self.last_stamp_ns = o.header.stamp_ns;
+        if o.command_accepted == 1 && o.command.command_id != self.command_id {
+            self.command_id = o.command.command_id;
+            (self.travelled_m, self.turned_rad, self.run_started) = (0.0, 0.0, false);
+        }
+        let mut step = Step { turn_rad: 0.0, run_m: 0.0, first_run: false };
+        if o.command_accepted == 1 {
+            step.turn_rad = map::wrap(o.turned_rad - self.turned_rad);
+            let sign = if o.command.distance_m < 0.0 { -1.0 } else { 1.0 };
+            step.run_m = sign * (o.travelled_m - self.travelled_m).max(0.0);
+            step.first_run = step.run_m != 0.0 && !self.run_started;
+            self.run_started |= step.first_run;
+            (self.travelled_m, self.turned_rad) = (o.travelled_m, o.turned_rad);
+        }
+        let mut map = self.map.clone();
+        self.grow(&mut map, step);
+        self.map = map.clone();
+        self.history.push_back((o.header.stamp_ns, map, step));
+        while self.history.front().is_some_and(|(t, ..)| t + self.config.history_ns < o.header.stamp_ns) {
+            self.history.pop_front();
+        }
+        let due: Vec<LandmarkSighting> =
+            self.pending.iter().copied().filter(|s| s.header.stamp_ns <= o.header.stamp_ns).collect();
+        self.pending.retain(|s| s.header.stamp_ns > o.header.stamp_ns);
+        let mut rejected = Vec::new();
+        for s in due {
+            if let Err(e) = self.apply_sighting(&s) {
+                rejected.push(e);
+            }
+        }
+        let mut out = vec![Output::Map(Box::new(self.publishable(o.header.stamp_ns)))];
+        out.extend(self.expectations(o.header.stamp_ns).into_iter().map(Output::Expectation));
+        if rejected.is_empty() { Ok(out) } else { Err(rejected.join("; ")) }
+    }
+
+    /// A sighting: checked, then applied at its stamp once odometry has reached it.
+    pub fn on_sighting(&mut self, s: &LandmarkSighting) -> Result<(), String> {
+        self.check_sighting(s)?;
+        if s.header.stamp_ns > self.last_stamp_ns {
+            self.pending.push(*s);
+            return Ok(());
+        }
+        self.apply_sighting(s)
+    }
+
+    fn check_sighting(&self, s: &LandmarkSighting) -> Result<(), String> {
+        let name = self.world.landmarks.get(s.landmark_index as usize).map(|l| l.name.as_str());
+        let name =
+            name.ok_or(format!("sighting of landmark #{} which is not in the world", s.landmark_index))?;
+        if SightingKind::from_raw(s.kind).is_none() {
+            return Err(format!("sighting of `{name}` has unknown kind {}", s.kind));
+        }
+        if ![s.a, s.a_sd, s.b, s.b_sd].iter().all(|v| v.is_finite()) {
+            return Err(format!("sighting of `{name}` holds a non-finite number"));
+        }
+        Ok(())
+    }
+
+    fn apply_sighting(&mut self, s: &LandmarkSighting) -> Result<(), String> {
+        let l = &self.world.landmarks[s.landmark_index as usize];
+        let obs = match SightingKind::from_raw(s.kind) {
+            Some(SightingKind::NotFound) | None => {
+                self.missed += 1;
+                return Ok(());
+            }
+            Some(SightingKind::Bearing) => Observation::Bearing { bearing_rad: s.a, sd_rad: s.a_sd },
+            Some(SightingKind::BearingRange) => Observation::BearingRange {
+                bearing_rad: s.a,
+                sd_rad: s.a_sd,
+                range_m: s.b,
+                range_sd_m: s.b_sd,
+            },
+            Some(SightingKind::GroundLine) => Observation::GroundLine {
+                heading_rad: s.a,
+                heading_sd_rad: s.a_sd,
+                offset_m: s.b,
+                offset_sd_m: s.b_sd,
+            },
+        };
+        let known = Known {
+            at: [l.position_m[0], l.position_m[1]],
+            to: l.to_m.map(|t| [t[0], t[1]]),
+            position_sd_m: l.position_sd_m,
+        };
+        // The map as it was at the sighting's stamp; then the growth since, replayed.
+        let i = self.history.iter().rposition(|(t, ..)| *t <= s.header.stamp_ns).ok_or(format!(
+            "sighting of `{}` at {} ns is older than the map's history: stamps out of order",
+            l.name, s.header.stamp_ns
+        ))?;
+        let mut m = reduction::apply(&self.history[i].1, &known, &obs, self.config.sigmas)
+            .map_err(|e| format!("sighting of `{}`: {e}", l.name))?;
+        self.history[i].1 = m.clone();
+        for j in i + 1..self.history.len() {
+            let step = self.history[j].2;
+            self.grow(&mut m, step);
+            self.history[j].1 = m.clone();
+        }
+        self.map = m;
+        self.missed = 0;
+        Ok(())
+    }
+
+    fn lost(&self) -> bool {
+        self.map.area_m2() > self.config.lost_area_m2 || self.missed >= self.config.lost_after_misses
+    }
+
+    fn publishable(&mut self, stamp_ns: u64) -> UncertaintyMap {
         self.seq += 1;
-        Ok(UncertaintyMap {
-            header: Header::new(self.seq, o.header.stamp_ns),
-            centre: p,
-            vertex_count: 4,
-            reserved: 0,
+        let m = &self.map;
+        let mut vertices_m = [[0.0; 2]; MAX_POLYGON_VERTICES];
+        for (v, p) in vertices_m.iter_mut().zip(&m.polygon) {
+            *v = *p;
+        }
+        UncertaintyMap {
+            header: Header::new(self.seq, stamp_ns),
+            centre: Pose2 { x_m: m.centre[0], y_m: m.centre[1], heading_rad: m.heading_rad },
+            vertex_count: m.polygon.len().min(MAX_POLYGON_VERTICES) as u32,
+            lost: u32::from(self.lost()),
             vertices_m,
-            heading_cw_rad: p.heading_rad - wedge_rad,
-            heading_ccw_rad: p.heading_rad + wedge_rad,
-            area_m2: 4.0 * along_m * cross_m,
-        })
+            heading_cw_rad: m.cw_rad,
+            heading_ccw_rad: m.ccw_rad,
+            area_m2: m.area_m2(),
+            missed_landmarks: self.missed,
+            reserved: 0,
+        }
+    }
+
+    /// Windows for the landmarks of the meadow under the map's centre that are active from it.
+    pub fn expectations(&self, stamp_ns: u64) -> Vec<Expectation> {
+        let m = &self.map;
+        let Some(meadow) = self.world.meadow_at(m.centre[0], m.centre[1]) else { return Vec::new() };
+        let (w, h) = self.config.image_px;
+        let view = View { camera: &self.world.camera, width_px: w, height_px: h };
+        self.world
+            .landmarks
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| {
+                meadow.landmarks.contains(&l.name)
+                    && l.active_from(m.centre[0], m.centre[1], m.heading_rad.to_degrees())
+            })
+            .filter_map(|(i, l)| {
+                let win = expecter::window(m, view, l, margin_px(l.strategy))?;
+                let class = match l.class {
+                    LandmarkClass::I => 1,
+                    LandmarkClass::II => 2,
+                    LandmarkClass::III => 3,
+                };
+                Some(Expectation {
+                    header: Header::new(self.seq, stamp_ns),
+                    landmark_index: i as u32,
+                    class,
+                    window_px: [win.u0 as f32, win.v0 as f32, win.u1 as f32, win.v1 as f32],
+                    width_px: w,
+                    height_px: h,
+                })
+            })
+            .collect()
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Tile, from the hallway world's copy of 002 Table 3.
-    fn tile() -> Terrain {
-        let world = include_str!("../../../worlds/hallway.toml");
-        harvey_world::load_str(world, "hallway.toml").expect("hallway loads").terrain["tile"].clone()
-    }
-
-    fn odo(x_m: f64) -> Odometry {
-        Odometry { world_from_robot: Pose2 { x_m, y_m: 0.0, heading_rad: 0.0 }, ..Default::default() }
-    }
-
-    #[test]
-    fn the_map_grows_with_distance_and_contains_the_pose() {
-        let mut u = Ums::new(tile());
-        let start = u.on_odometry(&odo(0.0)).expect("ok");
-        assert_eq!(start.area_m2, 0.0);
-        let mut last_area = 0.0;
-        for i in 1..=10 {
-            let m = u.on_odometry(&odo(i as f64)).expect("ok");
-            assert!(m.area_m2 > last_area, "area must grow");
-            last_area = m.area_m2;
-            let xs: Vec<f64> = m.vertices_m[..4].iter().map(|v| v[0]).collect();
-            assert!(xs.iter().any(|&x| x > i as f64) && xs.iter().any(|&x| x < i as f64));
-        }
-        // 10 m = 32.8 ft: along-track half-size 3 x 0.0028 x 32.8 ft plus the inertial loss.
-        let m = u.on_odometry(&odo(10.0)).expect("ok");
-        let along = (m.vertices_m[0][0] - 10.0) / FT;
-        assert!((along - (3.0 * 0.0028 * 10.0 / FT + 0.0084)).abs() < 1e-9, "{along}");
-        assert!(u.on_odometry(&odo(f64::NAN)).is_err());
-    }
-}
+mod tests;

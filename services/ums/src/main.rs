@@ -1,41 +1,80 @@
-//! harvey-ums: odometry in, the spatial uncertainty map out.
+//! harvey-ums: odometry and landmark sightings in; the uncertainty map and the Expecter's
+//! windows out.
 
 use std::path::PathBuf;
 
 use clap::Parser;
 use harvey_bus::{Bus, Waiter, Wake};
 use harvey_msgs::topics;
-use harvey_ums::Ums;
+use harvey_ums::{Config, Output, Ums};
 
 #[derive(Parser)]
-#[command(about = "Spatial uncertainty management")]
+#[command(about = "Spatial uncertainty management: the uncertainty map and the Expecter")]
 struct Args {
-    /// World file (for the terrain's error statistics).
+    /// World file: terrain statistics, meadows, landmarks, camera.
     #[arg(long)]
     world: PathBuf,
+    /// Probability of the map in standard deviations (002 §3.1: 2 or 3).
+    #[arg(long, default_value_t = 3.0)]
+    sigmas: f64,
+    /// Area above which the robot counts as lost.
+    #[arg(long, default_value_t = 4.0)]
+    lost_area_m2: f64,
+    /// Predicted landmarks missed in a row before the robot counts as lost.
+    #[arg(long, default_value_t = 3)]
+    lost_after_misses: u32,
+    /// How late a sighting may arrive and still be applied at its own stamp.
+    #[arg(long, default_value_t = 2000)]
+    history_ms: u64,
 }
 
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
+    anyhow::ensure!(
+        args.sigmas > 0.0 && args.lost_area_m2 > 0.0,
+        "--sigmas and --lost-area-m2 must be positive"
+    );
     let world = harvey_world::World::load(&args.world)?;
+    let image_px = (world.camera.width_px, world.camera.height_px);
+    let config = Config {
+        sigmas: args.sigmas,
+        lost_area_m2: args.lost_area_m2,
+        lost_after_misses: args.lost_after_misses,
+        history_ns: args.history_ms * 1_000_000,
+        image_px,
+    };
     let bus = Bus::join("ums")?;
     let odometry = bus.subscriber(topics::ODOMETRY)?;
-    let map = bus.publisher(topics::UMS_MAP)?;
+    let sightings = bus.subscriber(topics::VISION_SIGHTINGS)?;
+    let map_pub = bus.publisher(topics::UMS_MAP)?;
+    let expectations = bus.publisher(topics::UMS_EXPECTATIONS)?;
     let waiter = Waiter::new()?;
     let _a = waiter.attach(&odometry)?;
+    let _b = waiter.attach(&sightings)?;
     harvey_runtime::notify_ready()?;
 
-    let mut ums = Ums::new(world.ground_terrain().clone());
-    let mut batch = Vec::new();
+    let mut ums = Ums::new(world, config);
+    let (mut odos, mut seen) = (Vec::new(), Vec::new());
     while waiter.wait(None)? != Wake::Shutdown {
-        odometry.drain_into(&mut batch)?;
-        for o in &batch {
+        sightings.drain_into(&mut seen)?;
+        for s in &seen {
+            if let Err(e) = ums.on_sighting(s) {
+                tracing::warn!("rejected: {e}");
+            }
+        }
+        odometry.drain_into(&mut odos)?;
+        for o in &odos {
             match ums.on_odometry(o) {
-                Ok(m) => {
-                    map.send(&m)?;
+                Ok(out) => {
+                    for x in out {
+                        match x {
+                            Output::Map(m) => map_pub.send(&m)?,
+                            Output::Expectation(e) => expectations.send(&e)?,
+                        };
+                    }
                 }
-                Err(e) => tracing::warn!("ignoring odometry: {e}"),
+                Err(e) => tracing::warn!("rejected: {e}"),
             }
         }
     }

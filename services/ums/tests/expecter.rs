@@ -10,7 +10,8 @@ use harvey_ums::map::{Growth, Map};
 
 #[test]
 fn windows_contain_the_truth_and_beat_the_disk_model() {
-    let world = harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway");
+    let world =
+        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway");
     let view = View { camera: &world.camera, width_px: 640, height_px: 480 };
     let (mut sightings, mut inside, mut ratio_sum, mut ratios) = (0u32, 0u32, 0.0, 0u32);
     for seed in 0..500 {
@@ -19,7 +20,10 @@ fn windows_contain_the_truth_and_beat_the_disk_model() {
         let mut map = Map::exact(s.x_m, s.y_m, s.heading_deg.to_radians());
         for (i, (deg, ft)) in [(0.0, 8.0), (8.0, 6.0), (-8.0, 6.0)].iter().enumerate() {
             let id = 2 * i as u32 + 1;
-            for cmd in [Command::Turn { id, tenths_deg: (deg * 10.0) as i32 }, Command::Move { id: id + 1, hundredths_ft: (ft * 100.0) as i32 }] {
+            for cmd in [
+                Command::Turn { id, tenths_deg: (deg * 10.0) as i32 },
+                Command::Move { id: id + 1, hundredths_ft: (ft * 100.0) as i32 },
+            ] {
                 sim.handle(cmd);
                 while sim.is_moving() {
                     sim.tick();
@@ -52,7 +56,9 @@ fn windows_contain_the_truth_and_beat_the_disk_model() {
     }
     let rate = f64::from(inside) / f64::from(sightings);
     let ratio = ratio_sum / f64::from(ratios);
-    println!("{sightings} sightings: truth inside the window in {rate:.4}; polygon / disk window area = {ratio:.3}");
+    println!(
+        "{sightings} sightings: truth inside the window in {rate:.4}; polygon / disk window area = {ratio:.3}"
+    );
     assert!(sightings > 1000, "{sightings}");
     assert!(rate >= 0.99, "{rate}");
     assert!(ratio < 1.0, "{ratio}");

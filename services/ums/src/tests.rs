@@ -1,0 +1,134 @@
+//! Tests of the UMS state machine: growth from odometry, sightings at their stamps (late ones
+//! replayed), rejection of bad input without corrupting the map, and "lost".
+
+use harvey_msgs::{CommandKind, Header, LandmarkSighting, MotionCommand, Odometry, SightingKind};
+
+use crate::{Config, Output, Ums};
+
+fn hallway() -> harvey_world::World {
+    harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway")
+}
+
+fn ums() -> Ums {
+    let config = Config {
+        sigmas: 3.0,
+        lost_area_m2: 0.05,
+        lost_after_misses: 2,
+        history_ns: 2_000_000_000,
+        image_px: (640, 480),
+    };
+    Ums::new(hallway(), config)
+}
+
+fn odo(stamp_ms: u64, travelled_m: f64) -> Odometry {
+    let command = MotionCommand {
+        kind: CommandKind::Move as u32,
+        distance_m: 5.0,
+        command_id: 1,
+        ..Default::default()
+    };
+    Odometry {
+        header: Header::new(stamp_ms, stamp_ms * 1_000_000),
+        travelled_m,
+        command,
+        command_accepted: 1,
+        moving: 1,
+        ..Default::default()
+    }
+}
+
+fn map_of(out: &[Output]) -> &harvey_msgs::UncertaintyMap {
+    out.iter().find_map(|o| if let Output::Map(m) = o { Some(&**m) } else { None }).expect("a map")
+}
+
+fn sighting(stamp_ms: u64, landmark: &str, kind: SightingKind, a: f64, b: f64) -> LandmarkSighting {
+    let index = hallway().landmarks.iter().position(|l| l.name == landmark).expect("landmark") as u32;
+    LandmarkSighting {
+        header: Header::new(1, stamp_ms * 1_000_000),
+        landmark_index: index,
+        kind: kind as u32,
+        a,
+        a_sd: 0.005,
+        b,
+        b_sd: 0.05,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn odometry_grows_the_map_and_the_expecter_looks_ahead() {
+    let mut u = ums();
+    let mut last = 0.0;
+    for k in 1..=20 {
+        let out = u.on_odometry(&odo(k * 50, k as f64 * 0.2)).expect("ok");
+        let m = map_of(&out);
+        assert!(m.area_m2 >= last);
+        last = m.area_m2;
+        assert!(
+            (m.centre.x_m - k as f64 * 0.2 * (1.0 - 0.042)).abs() < 0.01,
+            "centre follows the mean motion"
+        );
+    }
+    let out = u.on_odometry(&odo(1050, 4.0)).expect("ok");
+    let windows: Vec<_> = out.iter().filter(|o| matches!(o, Output::Expectation(_))).collect();
+    assert!(!windows.is_empty(), "landmarks down the hall are expected");
+}
+
+#[test]
+fn a_late_sighting_applies_at_its_stamp_and_the_growth_since_is_replayed() {
+    let mut u = ums();
+    for k in 1..=10 {
+        u.on_odometry(&odo(k * 50, k as f64 * 0.3)).expect("ok");
+    }
+    let before = u.map().clone();
+    // At t = 300 ms the robot was on the centre line, heading along the hall: the north
+    // baseboard (a ground line along +x at y = 1) runs parallel, 1 m to its left.
+    u.on_sighting(&sighting(300, "north-baseboard", SightingKind::GroundLine, 0.0, -1.0)).expect("applied");
+    let after = u.map();
+    assert!(after.area_m2() < before.area_m2(), "{} -> {}", before.area_m2(), after.area_m2());
+    assert!(after.cw_rad + after.ccw_rad < before.cw_rad + before.ccw_rad);
+    // A sighting older than the history is out of order: rejected, the map untouched.
+    let snapshot = u.map().clone();
+    let mut old = sighting(0, "north-baseboard", SightingKind::GroundLine, 0.0, -1.0);
+    old.header.stamp_ns = 10;
+    assert!(u.on_sighting(&old).expect_err("too old").contains("stamps out of order"));
+    assert_eq!(u.map(), &snapshot);
+}
+
+#[test]
+fn bad_sightings_are_rejected_with_reasons_and_never_corrupt_the_map() {
+    let mut u = ums();
+    for k in 1..=5 {
+        u.on_odometry(&odo(k * 50, k as f64 * 0.2)).expect("ok");
+    }
+    let snapshot = u.map().clone();
+    let mut unknown = sighting(100, "office-sign", SightingKind::Bearing, 0.0, 0.0);
+    unknown.landmark_index = 999;
+    assert!(
+        u.on_sighting(&unknown).expect_err("unknown").contains("landmark #999 which is not in the world")
+    );
+    let nan = sighting(100, "office-sign", SightingKind::Bearing, f64::NAN, 0.0);
+    assert!(u.on_sighting(&nan).expect_err("nan").contains("non-finite"));
+    // The office sign straight behind the robot: no pose in the map sees it there.
+    let impossible = sighting(100, "office-sign", SightingKind::BearingRange, std::f64::consts::PI, 3.0);
+    assert!(u.on_sighting(&impossible).is_err());
+    assert_eq!(u.map(), &snapshot);
+    assert!(u.on_odometry(&odo(10, 0.0)).expect_err("old odometry").contains("older than the last"));
+}
+
+#[test]
+fn too_large_a_map_or_missed_landmarks_mean_lost() {
+    let mut u = ums();
+    let out = u.on_odometry(&odo(50, 0.1)).expect("ok");
+    assert_eq!(map_of(&out).lost, 0);
+    for k in 0..2 {
+        u.on_sighting(&sighting(50, "office-sign", SightingKind::NotFound, 0.0, 0.0)).expect("a miss");
+        let out = u.on_odometry(&odo(100 + k * 50, 0.1)).expect("ok");
+        assert_eq!(map_of(&out).missed_landmarks, k as u32 + 1);
+    }
+    assert_eq!(map_of(&u.on_odometry(&odo(300, 0.1)).expect("ok")).lost, 1, "two misses");
+    let mut far = ums();
+    let out = far.on_odometry(&odo(50, 6.0)).expect("ok");
+    assert!(map_of(&out).area_m2 > 0.05);
+    assert_eq!(map_of(&out).lost, 1, "area over the limit");
+}
