@@ -133,8 +133,14 @@ impl RunStats {
             out += &format!("  final error {:.3} m ({:.2} in) from the goal\n", err, err / 0.0254);
         }
         if let Some(m) = &self.last_map {
-            let wedge = (m.heading_ccw_rad - m.heading_cw_rad).to_degrees();
-            out += &format!("  uncertainty area {:.5} m^2, heading wedge {:.2} deg\n", m.area_m2, wedge);
+            let wedge = (m.heading_ccw_rad + m.heading_cw_rad).to_degrees();
+            out += &format!(
+                "  uncertainty area {:.5} m^2 ({} vertices), heading wedge {:.2} deg{}\n",
+                m.area_m2,
+                m.vertex_count,
+                wedge,
+                if m.lost == 1 { ", LOST" } else { "" }
+            );
         }
         out += &format!(
             "  data seen by the executive: {} sonar rings, {} detections, {} maps\n",

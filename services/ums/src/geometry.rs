@@ -194,10 +194,8 @@ mod tests {
 
     #[test]
     fn limiting_vertices_only_grows() {
-        let circle: Vec<Pt> = (0..100)
-            .map(|k| k as f64 * std::f64::consts::TAU / 100.0)
-            .map(|a| [a.cos(), a.sin()])
-            .collect();
+        let circle: Vec<Pt> =
+            (0..100).map(|k| k as f64 * std::f64::consts::TAU / 100.0).map(|a| [a.cos(), a.sin()]).collect();
         let h = hull(&circle);
         let small = limit_vertices(h.clone(), 12);
         assert!(small.len() <= 12);
