@@ -7,7 +7,24 @@ mod common;
 use std::collections::BTreeMap;
 use std::time::Duration;
 
-use harvey_msgs::{CommandKind, MissionState, MissionStatus, MotionCommand, TruePose, topics};
+use harvey_msgs::{
+    CommandKind, MissionState, MissionStatus, MotionCommand, TruePose, UncertaintyMap, topics,
+};
+
+/// Whether the map holds a pose: inside its convex polygon (with `tol`) and its heading wedge.
+fn holds(m: &UncertaintyMap, x: f64, y: f64, th: f64, tol: f64) -> bool {
+    let n = m.vertex_count as usize;
+    let v = &m.vertices_m[..n];
+    let inside = n < 3
+        || (0..n).all(|i| {
+            let (a, b) = (v[i], v[(i + 1) % n]);
+            let cross = (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
+            cross / (b[0] - a[0]).hypot(b[1] - a[1]) >= -tol
+        });
+    let d = (th - m.centre.heading_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+        - std::f64::consts::PI;
+    inside && d >= -m.heading_cw_rad - 1e-9 && d <= m.heading_ccw_rad + 1e-9
+}
 
 #[test]
 fn the_default_mission_runs_records_and_cleans_up() {
@@ -62,6 +79,7 @@ fn the_default_mission_runs_records_and_cleans_up() {
     let mut moves = 0;
     let mut last_status = None;
     let mut truth = Vec::new();
+    let mut maps = Vec::new();
     for m in mcap::MessageStream::new(&bytes).expect("mcap") {
         let m = m.expect("valid message");
         let topic = m.channel.topic.trim_start_matches('/').to_owned();
@@ -75,11 +93,11 @@ fn the_default_mission_runs_records_and_cleans_up() {
                 last_status = Some(harvey_cdr::decode::<MissionStatus>(&m.data).expect("status"))
             }
             "sim/truth" => truth.push(harvey_cdr::decode::<TruePose>(&m.data).expect("truth")),
+            "ums/map" => maps.push(harvey_cdr::decode::<UncertaintyMap>(&m.data).expect("map")),
             _ => {}
         }
     }
-    // Landmark sightings come from the vision issue's recognisers; nothing publishes them yet.
-    for t in topics::ALL.iter().filter(|t| **t != topics::VISION_SIGHTINGS.name) {
+    for t in topics::ALL {
         assert!(counts.get(*t).copied().unwrap_or(0) > 0, "no message on {t}: {counts:?}");
     }
     assert!(counts["camera/frame"] >= 50, "{counts:?}");
@@ -97,6 +115,26 @@ fn the_default_mission_runs_records_and_cleans_up() {
     assert!((last.x_m - max_x + 1.9).abs() < 0.15, "came back about 2 m: {last:?}");
     // Stamps come from simulated time: strictly increasing, 50 ms apart.
     assert!(truth.windows(2).all(|w| w[1].header.stamp_ns == w[0].header.stamp_ns + 50_000_000));
+
+    // The UMS's map holds the true pose throughout, vision's landmark sightings included, and
+    // those sightings keep it smaller than dead reckoning alone would (0.58 m^2 here).
+    let sightings = counts.get("vision/sightings").copied().unwrap_or(0);
+    assert!(sightings > 50, "door jambs recognised in their windows: {sightings}");
+    let mut checked = 0;
+    for m in &maps {
+        if let Some(t) = truth.iter().find(|t| t.header.stamp_ns == m.header.stamp_ns) {
+            let p = t.world_from_robot;
+            assert!(
+                holds(m, p.x_m, p.y_m, p.heading_rad, 1e-6),
+                "truth {p:?} outside the map at {} ns: {m:?}",
+                m.header.stamp_ns
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 400, "{checked} maps checked against the truth");
+    let last = maps.last().expect("maps");
+    assert!(last.area_m2 < 0.3, "final area {}", last.area_m2);
 
     // Nothing left behind.
     std::thread::sleep(Duration::from_millis(100));

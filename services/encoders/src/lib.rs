@@ -8,8 +8,10 @@ use harvey_msgs::{EncodersRaw, Header, MotionCommand, Odometry, Pose2};
 #[derive(Debug, Default)]
 pub struct OdometryBuilder {
     command: MotionCommand,
-    /// Encoder pose when the current command was first reported as accepted.
+    /// Encoder pose just before the current command took effect.
     start: Option<Pose2>,
+    /// The pose of the previous report: the last one before a newly accepted command moved.
+    previous: Option<Pose2>,
     seq: u64,
     last_stamp_ns: u64,
 }
@@ -40,8 +42,11 @@ impl OdometryBuilder {
         let pose = Pose2 { x_m: e.x_m, y_m: e.y_m, heading_rad: e.heading_rad };
         let accepted = self.command.command_id != 0 && e.command_id == self.command.command_id;
         if accepted && self.start.is_none() {
-            self.start = Some(pose);
+            // The DRV's first report naming the command already includes its first tick of
+            // motion: count from the report before it.
+            self.start = Some(self.previous.unwrap_or(pose));
         }
+        self.previous = Some(pose);
         let (travelled_m, turned_rad) = match self.start {
             Some(s) => {
                 ((pose.x_m - s.x_m).hypot(pose.y_m - s.y_m), wrap_pi(pose.heading_rad - s.heading_rad))
@@ -82,7 +87,9 @@ mod tests {
         });
         let before = o.on_encoders(&enc(2, 0.5, 0.0, 0, 0)).expect("ok");
         assert_eq!((before.command_accepted, before.travelled_m), (0, 0.0));
-        o.on_encoders(&enc(3, 0.5, 0.0, 3, 1)).expect("ok");
+        // The first report naming the command has already moved 0.1 m: it counts.
+        let first = o.on_encoders(&enc(3, 0.6, 0.0, 3, 1)).expect("ok");
+        assert!((first.travelled_m - 0.1).abs() < 1e-12, "{}", first.travelled_m);
         let later = o.on_encoders(&enc(4, 1.7, 0.0, 3, 1)).expect("ok");
         assert_eq!(later.command_accepted, 1);
         assert!((later.travelled_m - 1.2).abs() < 1e-12);

@@ -114,7 +114,9 @@ impl Growth<'_> {
         let mean_ft = ft - t.translational_loss_ft_per_ft * ft - inertial;
         let spread_ft = self.sigmas * t.translational_sd_ft_per_ft * ft;
         let s_min = (mean_ft - spread_ft).max(0.0) * FT;
-        let s_max = (mean_ft + spread_ft).min(ft).max(0.0) * FT;
+        // The inertial loss may not have happened yet part way through a move: it only
+        // lowers the near bound.
+        let s_max = (mean_ft + inertial + spread_ft).min(ft).max(0.0) * FT;
         // Drift, treated symmetrically (002 §3.2: "by overestimation ... a fixed factor").
         let drift = ((t.drift_deg_per_ft + self.sigmas * t.drift_sd_deg_per_ft) * ft).to_radians();
         let sign = if distance_m < 0.0 { std::f64::consts::PI } else { 0.0 };

@@ -4,6 +4,8 @@
 use harvey_msgs::{Detections, Feature, FrameHeader, Header, MAX_FEATURES};
 
 /// Algorithm ids carried in [`Detections::algorithm`].
+pub mod landmarks;
+
 pub const ALGO_VERTICAL_EDGES: u32 = 1;
 
 /// Finds vertical edges in a band of rows; keeps its scratch between frames.

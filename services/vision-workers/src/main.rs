@@ -1,46 +1,75 @@
 //! harvey-vision-workers: runs perceptual algorithms on camera frames read in place from shared
-//! memory and publishes what they find.
+//! memory: vertical edges across the frame, and the landmarks the Expecter asks for, inside
+//! their windows.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
 
 use clap::Parser;
 use harvey_bus::{Bus, Waiter, Wake};
-use harvey_msgs::topics;
+use harvey_msgs::{Expectation, topics};
 use harvey_vision_workers::VerticalEdges;
+use harvey_vision_workers::landmarks::LineLandmarks;
 
 #[derive(Parser)]
 #[command(about = "Vision workers on shared-memory camera frames")]
 struct Args {
+    /// World file (for the camera calibration).
+    #[arg(long)]
+    world: PathBuf,
     /// Half-height of the band searched for vertical edges, in rows.
     #[arg(long, default_value_t = 24)]
     band_half_rows: u32,
     /// Edge strength threshold in grey levels.
     #[arg(long, default_value_t = 12.0)]
     edge_threshold: f32,
+    /// Expectations older than this (message time) are not searched for.
+    #[arg(long, default_value_t = 300)]
+    expectation_max_age_ms: u64,
 }
 
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
+    let world = harvey_world::World::load(&args.world)?;
     let bus = Bus::join("vision-workers")?;
     let frames = bus.frame_subscriber(topics::CAMERA_FRAME)?;
+    let expectations = bus.subscriber(topics::UMS_EXPECTATIONS)?;
     let detections = bus.publisher(topics::VISION_DETECTIONS)?;
+    let sightings = bus.publisher(topics::VISION_SIGHTINGS)?;
     let waiter = Waiter::new()?;
     let _a = waiter.attach(&frames)?;
+    let _b = waiter.attach(&expectations)?;
     harvey_runtime::notify_ready()?;
 
     let mut edges = VerticalEdges::new(args.band_half_rows, args.edge_threshold);
-    let mut processed = 0u64;
+    let mut lines = LineLandmarks::new(world.camera.focal_px, args.edge_threshold);
+    let mut wanted: BTreeMap<u32, Expectation> = BTreeMap::new();
+    let max_age_ns = args.expectation_max_age_ms * 1_000_000;
+    let (mut processed, mut found) = (0u64, 0u64);
     while waiter.wait(None)? != Wake::Shutdown {
+        expectations.drain(|e| {
+            wanted.insert(e.landmark_index, *e);
+        })?;
         // Work on the newest frame only: a late worker skips, it does not fall further behind.
-        if let Some(frame) = frames.latest()? {
-            match edges.run(frame.header(), frame.pixels()) {
-                Ok(d) => {
-                    detections.send(&d)?;
-                    processed += 1;
-                }
-                Err(e) => tracing::warn!("skipping a frame: {e}"),
+        let Some(frame) = frames.latest()? else { continue };
+        let h = *frame.header();
+        match edges.run(&h, frame.pixels()) {
+            Ok(d) => {
+                detections.send(&d)?;
+                processed += 1;
+            }
+            Err(e) => tracing::warn!("skipping a frame: {e}"),
+        }
+        lines.focal_px = world.camera.focal_for(h.width_px);
+        wanted.retain(|_, e| e.header.stamp_ns + max_age_ns >= h.stamp_ns);
+        for e in wanted.values() {
+            if let Some(s) = lines.recognise(&h, frame.pixels(), e) {
+                found += u64::from(s.kind != 0);
+                sightings.send(&s)?;
             }
         }
     }
-    tracing::info!(processed, "vision workers stopped");
+    tracing::info!(processed, found, "vision workers stopped");
     Ok(())
 }
