@@ -95,7 +95,7 @@ mod tests {
         (0..64 * 48)
             .map(|i| {
                 let u = i % 64;
-                edges.iter().filter(|(at, _)| u >= *at).map(|(_, v)| *v).last().unwrap_or(50)
+                edges.iter().rev().find(|(at, _)| u >= *at).map_or(50, |(_, v)| *v)
             })
             .collect()
     }
