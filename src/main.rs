@@ -31,6 +31,12 @@ enum Cmd {
     },
     /// Topics, counts, rates, duration and gaps of a recording.
     Info { recording: PathBuf },
+    /// Draw an MCAP recording into a Rerun file (`rerun run.rrd` opens it).
+    Export {
+        recording: PathBuf,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
 }
 
 #[derive(clap::Args)]
@@ -103,6 +109,23 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
         }
         Cmd::Info { recording } => {
             print!("{}", summary::RunStats::read(&recording)?.info_table());
+            Ok(0)
+        }
+        Cmd::Export { recording, output } => {
+            let mut shown = 0;
+            let drawn = harvey_recorder::export::export(&recording, &output, |done, total| {
+                let pct = (done * 100).checked_div(total).unwrap_or(100);
+                if pct >= shown {
+                    eprint!(
+                        "\rexporting {}: [{:<50}] {pct:>3}%",
+                        recording.display(),
+                        "#".repeat((pct / 2) as usize)
+                    );
+                    shown = pct + 2;
+                }
+            })?;
+            eprintln!();
+            println!("{}: {drawn} messages drawn", output.display());
             Ok(0)
         }
     }

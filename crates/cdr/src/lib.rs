@@ -8,4 +8,4 @@ mod types;
 
 pub use codec::{Cdr, CdrError, CdrReader, CdrWriter, decode, encode};
 pub use schema::{Def, full_text};
-pub use types::{Ros2Msg, encode_image, image_def};
+pub use types::{Ros2Msg, decode_image, encode_image, image_def};

@@ -70,6 +70,33 @@ pub fn encode_image(h: &FrameHeader, pixels: &[u8], buf: Vec<u8>) -> Vec<u8> {
     w.finish()
 }
 
+/// Decodes a `sensor_msgs/msg/Image` back to a frame header (sequence number 0: the standard
+/// type has none) and its pixels, borrowed from `data`.
+pub fn decode_image(data: &[u8]) -> Result<(FrameHeader, &[u8]), CdrError> {
+    let mut r = CdrReader::new(data)?;
+    let sec = r.prim::<i32>()?;
+    let nanosec = r.prim::<u32>()?;
+    let _frame_id = r.string()?;
+    let height_px = r.prim::<u32>()?;
+    let width_px = r.prim::<u32>()?;
+    let at = data.len() - r.remaining();
+    let encoding = r.string()?;
+    let enc = harvey_msgs::Encoding::parse(&encoding)
+        .ok_or(CdrError::Invalid { at, what: format!("image encoding `{encoding}` is not mono8 or rgb8") })?;
+    let _bigendian = r.prim::<u8>()?;
+    let stride_bytes = r.prim::<u32>()?;
+    let pixels = r.byte_seq()?;
+    let stamp_ns = u64::try_from(sec).unwrap_or(0) * 1_000_000_000 + u64::from(nanosec);
+    let h = FrameHeader { seq: 0, stamp_ns, width_px, height_px, stride_bytes, encoding: enc as u32 };
+    if pixels.len() != h.payload_len() {
+        return Err(CdrError::Invalid {
+            at,
+            what: format!("{} pixel bytes for a {width_px}x{height_px} {encoding} image", pixels.len()),
+        });
+    }
+    Ok((h, pixels))
+}
+
 macro_rules! ros2_struct {
     ($t:ty, $def:ident = ($name:literal, $text:expr, [$($dep:expr),*]) { $($f:ident),* $(,)? }) => {
         static $def: Def = Def { name: $name, text: $text, deps: &[$($dep),*] };
@@ -241,5 +268,11 @@ mod tests {
         assert_eq!(r.byte_seq().expect("data"), &[1, 2, 3, 4]);
         assert_eq!(r.remaining(), 0);
         assert_eq!(image_def().schema_name(), "sensor_msgs/msg/Image");
+        let (back, px) = decode_image(&bytes).expect("decodes");
+        assert_eq!(
+            (back.stamp_ns, back.width_px, back.height_px, px),
+            (1_000_000_005, 2, 2, &[1u8, 2, 3, 4][..])
+        );
+        assert!(decode_image(&bytes[..bytes.len() - 1]).is_err());
     }
 }

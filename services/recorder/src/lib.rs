@@ -8,12 +8,19 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
+pub mod draw;
+pub mod export;
+pub mod rrd;
+
 use harvey_cdr::{Def, Ros2Msg, encode, encode_image, full_text, image_def};
 use harvey_msgs::FrameHeader;
 use mcap::records::{MessageHeader, Metadata};
 
 /// QoS that ROS 2 tools expect on a channel: reliable, volatile, keep-last 16 (rosbag2's YAML).
 const QOS_YAML: &str = "- history: 1\n  depth: 16\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 2147483647\n    nsec: 4294967295\n  lifespan:\n    sec: 2147483647\n    nsec: 4294967295\n  liveliness: 1\n  liveliness_lease_duration:\n    sec: 2147483647\n    nsec: 4294967295\n  avoid_ros_namespace_conventions: false";
+
+/// Media type of the world file attached to a recording.
+pub const WORLD_MEDIA_TYPE: &str = "application/toml; harvey-world";
 
 /// MCAP's chunk size: large enough to compress well, small enough to bound a crash's loss.
 const CHUNK_BYTES: u64 = 4 << 20;
@@ -120,6 +127,18 @@ impl Recorder {
     pub fn record_frame(&mut self, ch: Channel, h: &FrameHeader, pixels: &[u8]) -> Result<(), RecordError> {
         self.scratch = encode_image(h, pixels, std::mem::take(&mut self.scratch));
         self.write(ch, h.seq, h.stamp_ns)
+    }
+
+    /// Stores the world file the run used, so that offline tools (`harvey export`) can draw it.
+    pub fn attach_world(&mut self, name: &str, text: &str) -> Result<(), RecordError> {
+        let a = mcap::Attachment {
+            log_time: 0,
+            create_time: 0,
+            name: name.to_owned(),
+            media_type: WORLD_MEDIA_TYPE.to_owned(),
+            data: std::borrow::Cow::Borrowed(text.as_bytes()),
+        };
+        self.writer.attach(&a).map_err(|e| self.err(e))
     }
 
     /// Ends the current chunk and pushes it to the file: what is recorded so far survives a crash.

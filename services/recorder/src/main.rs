@@ -1,14 +1,17 @@
-//! harvey-recorder: subscribes to every topic and writes them to `run.mcap`. It never slows a
-//! publisher (its queues overwrite when full; the gaps are counted), flushes a chunk at least every
-//! second, and finishes the file on SIGINT/SIGTERM.
+//! harvey-recorder: subscribes to every topic and writes them to `run.mcap` (and, with `--rrd`,
+//! draws them into a Rerun file). It never slows a publisher (its queues overwrite when full; the
+//! gaps are counted), flushes at least every second, and finishes the files on SIGINT/SIGTERM.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
+use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, FrameSubscriber, Subscriber, Waitable, Waiter, Wake};
 use harvey_cdr::Ros2Msg;
 use harvey_msgs::{Message, Topic, topics};
+use harvey_recorder::draw::Draw;
+use harvey_recorder::rrd::RrdWriter;
 use harvey_recorder::{Channel, Recorder};
 
 #[derive(Parser)]
@@ -20,12 +23,24 @@ struct Args {
     /// Longest time between flushes (the most a SIGKILL can lose).
     #[arg(long, default_value_t = 500)]
     flush_ms: u64,
+    /// Also draw the run into this Rerun (.rrd) file.
+    #[arg(long)]
+    rrd: Option<PathBuf>,
+    /// The world file of the run: attached to the MCAP file and drawn in the Rerun file.
+    #[arg(long)]
+    world: Option<PathBuf>,
+}
+
+/// Where recorded messages go.
+struct Sinks {
+    mcap: Recorder,
+    rrd: Option<RrdWriter>,
 }
 
 /// A subscribed topic feeding a channel.
 trait Tap {
     fn waitable(&self) -> &dyn Waitable;
-    fn drain(&self, rec: &mut Recorder) -> anyhow::Result<usize>;
+    fn drain(&self, out: &mut Sinks) -> anyhow::Result<usize>;
 }
 
 struct MsgTap<T: Message> {
@@ -33,15 +48,18 @@ struct MsgTap<T: Message> {
     channel: Channel,
 }
 
-impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
+impl<T: Message + Ros2Msg + Draw> Tap for MsgTap<T> {
     fn waitable(&self) -> &dyn Waitable {
         &self.sub
     }
-    fn drain(&self, rec: &mut Recorder) -> anyhow::Result<usize> {
+    fn drain(&self, out: &mut Sinks) -> anyhow::Result<usize> {
         let mut written = Ok(());
         let n = self.sub.drain(|m| {
             if written.is_ok() {
-                written = rec.record(self.channel, m);
+                written = out.mcap.record(self.channel, m);
+            }
+            if let (Ok(()), Some(rrd)) = (&written, out.rrd.as_mut()) {
+                written = m.draw(rrd);
             }
         })?;
         written?;
@@ -58,17 +76,24 @@ impl Tap for FrameTap {
     fn waitable(&self) -> &dyn Waitable {
         &self.sub
     }
-    fn drain(&self, rec: &mut Recorder) -> anyhow::Result<usize> {
+    fn drain(&self, out: &mut Sinks) -> anyhow::Result<usize> {
         let mut n = 0;
         while let Some(frame) = self.sub.take()? {
-            rec.record_frame(self.channel, frame.header(), frame.pixels())?;
+            out.mcap.record_frame(self.channel, frame.header(), frame.pixels())?;
+            if let Some(rrd) = out.rrd.as_mut() {
+                rrd.frame(frame.header(), frame.pixels())?;
+            }
             n += 1;
         }
         Ok(n)
     }
 }
 
-fn tap<T: Message + Ros2Msg>(bus: &Bus, rec: &mut Recorder, topic: Topic<T>) -> anyhow::Result<Box<dyn Tap>> {
+fn tap<T: Message + Ros2Msg + Draw>(
+    bus: &Bus,
+    rec: &mut Recorder,
+    topic: Topic<T>,
+) -> anyhow::Result<Box<dyn Tap>> {
     let channel = rec.channel::<T>(topic.name)?;
     Ok(Box::new(MsgTap { sub: bus.subscriber(topic)?, channel }))
 }
@@ -77,6 +102,18 @@ fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
     let mut rec = Recorder::create(&args.output)?;
+    let world = match &args.world {
+        Some(path) => {
+            let text =
+                std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+            let name = path.file_name().map_or("world.toml".into(), |n| n.to_string_lossy().into_owned());
+            let world = harvey_world::load_str(&text, &path.display().to_string())?;
+            rec.attach_world(&name, &text)?;
+            Some(world)
+        }
+        None => None,
+    };
+    let rrd = args.rrd.as_ref().map(|p| RrdWriter::create(p, world.as_ref())).transpose()?;
     let bus = Bus::join("recorder")?;
     let frame_channel = rec.image_channel(topics::CAMERA_FRAME.name)?;
     let taps: Vec<Box<dyn Tap>> = vec![
@@ -96,6 +133,7 @@ fn main() -> anyhow::Result<()> {
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();
     let missing: Vec<&&str> = topics::ALL.iter().filter(|t| !recorded.contains(t)).collect();
     anyhow::ensure!(missing.is_empty(), "the recorder has no tap for {missing:?}");
+    let mut sinks = Sinks { mcap: rec, rrd };
 
     let waiter = Waiter::new()?;
     let waitables: Vec<&dyn Waitable> = taps.iter().map(|t| t.waitable()).collect();
@@ -108,10 +146,13 @@ fn main() -> anyhow::Result<()> {
     loop {
         let wake = waiter.wait(Some(flush_every))?;
         for t in &taps {
-            t.drain(&mut rec)?;
+            t.drain(&mut sinks)?;
         }
         if last_flush.elapsed() >= flush_every {
-            rec.flush()?;
+            sinks.mcap.flush()?;
+            if let Some(rrd) = &sinks.rrd {
+                rrd.flush()?;
+            }
             last_flush = Instant::now();
         }
         if wake == Wake::Shutdown {
@@ -119,7 +160,10 @@ fn main() -> anyhow::Result<()> {
         }
     }
     drop(_attached);
-    let stats = rec.finish()?;
+    let stats = sinks.mcap.finish()?;
+    if let Some(rrd) = sinks.rrd {
+        rrd.finish()?;
+    }
     let total: u64 = stats.iter().map(|s| s.messages).sum();
     let gaps: u64 = stats.iter().map(|s| s.seq_gaps).sum();
     tracing::info!(messages = total, seq_gaps = gaps, output = %args.output.display(), "recording finished");
