@@ -175,6 +175,13 @@ impl World {
             .map_or(self.floor.reflectance, |(_, r)| r)
     }
 
+    /// The centre (vertex mean) of the first meadow of `terrain`, if any: a place to stand on it.
+    pub fn meadow_centre(&self, terrain: &str) -> Option<[f64; 2]> {
+        let m = self.meadows.iter().find(|m| m.terrain == terrain)?;
+        let n = m.outline.len() as f64;
+        Some(m.outline.iter().fold([0.0, 0.0], |c, p| [c[0] + p[0] / n, c[1] + p[1] / n]))
+    }
+
     /// The innermost locale whose outline contains `(x, y)`.
     pub fn locale_at(&self, x: f64, y: f64) -> Option<&Locale> {
         self.locales

@@ -12,10 +12,9 @@ const RUNS: u64 = 500;
 fn campus_on(terrain: &str) -> World {
     let mut w =
         harvey_world::load_str(include_str!("../../../worlds/campus.toml"), "campus.toml").expect("campus");
-    let m = w.meadows.iter().find(|m| m.terrain == terrain).expect("meadow");
-    let n = m.outline.len() as f64;
-    let (x, y) = m.outline.iter().fold((0.0, 0.0), |(x, y), p| (x + p[0] / n, y + p[1] / n));
+    let [x, y] = w.meadow_centre(terrain).expect("a meadow of each terrain");
     (w.start.x_m, w.start.y_m) = (x, y);
+    assert_eq!(w.meadow_at(x, y).map(|m| m.terrain.as_str()), Some(terrain));
     w
 }
 
