@@ -31,6 +31,12 @@ enum Cmd {
     },
     /// Topics, counts, rates, duration and gaps of a recording.
     Info { recording: PathBuf },
+    /// Salvage every complete chunk of a recording whose writer died into a valid file.
+    Recover {
+        recording: PathBuf,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
     /// Draw an MCAP recording into a Rerun file (`rerun run.rrd` opens it).
     Export {
         recording: PathBuf,
@@ -109,6 +115,17 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
         }
         Cmd::Info { recording } => {
             print!("{}", summary::RunStats::read(&recording)?.info_table());
+            Ok(0)
+        }
+        Cmd::Recover { recording, output } => {
+            let s = harvey_recorder::recover::recover(&recording, &output)?;
+            println!(
+                "{}: {} messages and {} attachments salvaged{}",
+                output.display(),
+                s.messages,
+                s.attachments,
+                s.stopped_at.map(|e| format!(" (the rest was lost: {e})")).unwrap_or_default()
+            );
             Ok(0)
         }
         Cmd::Export { recording, output } => {

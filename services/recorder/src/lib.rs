@@ -10,6 +10,7 @@ use std::path::{Path, PathBuf};
 
 pub mod draw;
 pub mod export;
+pub mod recover;
 pub mod rrd;
 
 use harvey_cdr::{Def, Ros2Msg, encode, encode_image, full_text, image_def};
