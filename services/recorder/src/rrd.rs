@@ -40,7 +40,12 @@ pub struct RrdWriter {
     last_state: Option<(u32, u32)>,
     /// (focal, width, height) of the camera, to draw sightings' bearings on the image.
     camera: Option<(f64, f64, f64)>,
+    /// Stamp of each landmark's latest Expecter window: windows not renewed are cleared.
+    windows: std::collections::BTreeMap<u32, u64>,
 }
+
+/// A window not renewed for this long (message time) is taken off the image.
+const WINDOW_LIFETIME_NS: u64 = 300_000_000;
 
 impl RrdWriter {
     /// Creates the file with Harvey's blueprint, and draws the world's walls and landmarks.
@@ -64,7 +69,14 @@ impl RrdWriter {
             .map_err(|e| err(&e))?;
         let camera =
             world.map(|w| (w.camera.focal_px, f64::from(w.camera.width_px), f64::from(w.camera.height_px)));
-        let mut w = Self { rec, path: path.display().to_string(), pose: None, last_state: None, camera };
+        let mut w = Self {
+            rec,
+            path: path.display().to_string(),
+            pose: None,
+            last_state: None,
+            camera,
+            windows: Default::default(),
+        };
         if let Some(world) = world {
             w.draw_world(world)?;
         }
@@ -156,6 +168,18 @@ impl RrdWriter {
         self.rec
             .log("plots/uncertainty_area_m2", &rerun::Scalars::single(m.area_m2))
             .map_err(|e| self.err(e))?;
+        let stale: Vec<u32> = self
+            .windows
+            .iter()
+            .filter(|(_, t)| **t + WINDOW_LIFETIME_NS < m.header.stamp_ns)
+            .map(|(i, _)| *i)
+            .collect();
+        for i in stale {
+            self.windows.remove(&i);
+            self.rec
+                .log(format!("camera/image/expectations/{i}"), &rerun::Clear::flat())
+                .map_err(|e| self.err(e))?;
+        }
         let wedge_deg = (m.heading_cw_rad + m.heading_ccw_rad).to_degrees();
         self.rec.log("plots/heading_wedge_deg", &rerun::Scalars::single(wedge_deg)).map_err(|e| self.err(e))
     }
@@ -173,6 +197,7 @@ impl RrdWriter {
 
     pub fn expectation(&mut self, e: &Expectation) -> Result<(), RecordError> {
         self.at(e.header.stamp_ns);
+        self.windows.insert(e.landmark_index, e.header.stamp_ns);
         let [u0, v0, u1, v1] = e.window_px;
         let boxes = rerun::Boxes2D::from_mins_and_sizes([(u0, v0)], [(u1 - u0, v1 - v0)])
             .with_labels([format!("landmark {}", e.landmark_index)]);
