@@ -105,6 +105,10 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
                     stats.message_count(),
                     stats.topics.len()
                 );
+                let rrd = run_dir.join("run.rrd");
+                if rrd.is_file() {
+                    println!("view it:   rerun {}", rrd.display());
+                }
             }
             Ok(outcome.exit_code())
         }
