@@ -133,7 +133,8 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             Ok(0)
         }
         Cmd::Export { recording, output } => {
-            let mut shown = 0;
+            // A progress bar for people; logs get only the result line.
+            let mut shown = if std::io::IsTerminal::is_terminal(&std::io::stderr()) { 0 } else { u64::MAX };
             let drawn = harvey_recorder::export::export(&recording, &output, |done, total| {
                 let pct = (done * 100).checked_div(total).unwrap_or(100);
                 if pct >= shown {
@@ -145,7 +146,9 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
                     shown = pct + 2;
                 }
             })?;
-            eprintln!();
+            if shown != u64::MAX {
+                eprintln!();
+            }
             println!("{}: {drawn} messages drawn", output.display());
             Ok(0)
         }
