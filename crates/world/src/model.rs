@@ -182,6 +182,18 @@ impl World {
         Some(m.outline.iter().fold([0.0, 0.0], |c, p| [c[0] + p[0] / n, c[1] + p[1] / n]))
     }
 
+    /// Moves the start to the centre of a meadow of `terrain` (for experiments on one terrain);
+    /// false when no meadow has it.
+    pub fn start_on_terrain(&mut self, terrain: &str) -> bool {
+        match self.meadow_centre(terrain) {
+            Some([x, y]) if self.meadow_at(x, y).is_some_and(|m| m.terrain == terrain) => {
+                (self.start.x_m, self.start.y_m) = (x, y);
+                true
+            }
+            _ => false,
+        }
+    }
+
     /// The innermost locale whose outline contains `(x, y)`.
     pub fn locale_at(&self, x: f64, y: f64) -> Option<&Locale> {
         self.locales

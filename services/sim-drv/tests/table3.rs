@@ -15,9 +15,7 @@ const RUNS: u64 = 1000;
 fn campus_on(terrain: &str) -> World {
     let mut w =
         harvey_world::load_str(include_str!("../../../worlds/campus.toml"), "campus.toml").expect("campus");
-    let [x, y] = w.meadow_centre(terrain).expect("a meadow of each terrain");
-    (w.start.x_m, w.start.y_m) = (x, y);
-    assert_eq!(w.meadow_at(x, y).map(|m| m.terrain.as_str()), Some(terrain));
+    assert!(w.start_on_terrain(terrain), "a meadow of {terrain}");
     w
 }
 
