@@ -11,21 +11,6 @@ use harvey_msgs::{
     CommandKind, MissionState, MissionStatus, MotionCommand, TruePose, UncertaintyMap, topics,
 };
 
-/// Whether the map holds a pose: inside its convex polygon (with `tol`) and its heading wedge.
-fn holds(m: &UncertaintyMap, x: f64, y: f64, th: f64, tol: f64) -> bool {
-    let n = m.vertex_count as usize;
-    let v = &m.vertices_m[..n];
-    let inside = n < 3
-        || (0..n).all(|i| {
-            let (a, b) = (v[i], v[(i + 1) % n]);
-            let cross = (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
-            cross / (b[0] - a[0]).hypot(b[1] - a[1]) >= -tol
-        });
-    let d = (th - m.centre.heading_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-        - std::f64::consts::PI;
-    inside && d >= -m.heading_cw_rad - 1e-9 && d <= m.heading_ccw_rad + 1e-9
-}
-
 #[test]
 fn the_default_mission_runs_records_and_cleans_up() {
     let prefix = common::unique_prefix("ws");
@@ -125,7 +110,7 @@ fn the_default_mission_runs_records_and_cleans_up() {
         if let Some(t) = truth.iter().find(|t| t.header.stamp_ns == m.header.stamp_ns) {
             let p = t.world_from_robot;
             assert!(
-                holds(m, p.x_m, p.y_m, p.heading_rad, 1e-6),
+                common::holds(m, p.x_m, p.y_m, p.heading_rad, 1e-6),
                 "truth {p:?} outside the map at {} ns: {m:?}",
                 m.header.stamp_ns
             );

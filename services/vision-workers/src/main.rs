@@ -23,6 +23,9 @@ struct Args {
     /// Edge strength threshold in grey levels.
     #[arg(long, default_value_t = 12.0)]
     edge_threshold: f32,
+    /// Look for the landmarks the Expecter asks for (`false`: dead reckoning only, 002 Fig. 79).
+    #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
+    landmarks: bool,
     /// Expectations older than this (message time) are not searched for.
     #[arg(long, default_value_t = 300)]
     expectation_max_age_ms: u64,
@@ -63,7 +66,7 @@ fn main() -> anyhow::Result<()> {
         }
         lines.focal_px = world.camera.focal_for(h.width_px);
         wanted.retain(|_, e| e.header.stamp_ns + max_age_ns >= h.stamp_ns);
-        for e in wanted.values() {
+        for e in wanted.values().filter(|_| args.landmarks) {
             if let Some(s) = lines.recognise(&h, frame.pixels(), e) {
                 found += u64::from(s.kind != 0);
                 sightings.send(&s)?;
