@@ -141,3 +141,28 @@ impl Growth<'_> {
         map.ccw_rad += drift;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn growth_from_a_start_region_holds_every_starting_point() {
+        let w =
+            harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway");
+        let g = Growth { terrain: &w.terrain["tile"], sigmas: 3.0 };
+        let start = [[0.0, -0.1], [0.2, -0.1], [0.2, 0.1], [0.0, 0.1]];
+        let mut map = Map::region(&start, 0.0, 0.02, 0.02);
+        assert!((map.area_m2() - 0.04).abs() < 1e-12 && map.centre == [0.1, 0.0]);
+        g.turn(&mut map, 0.5);
+        g.run(&mut map, 2.0, true);
+        // Every start point moved by the mean motion stays inside the grown map.
+        let heading = map.heading_rad;
+        let s = 2.0 * (1.0 - 0.042) - 0.0084 * 0.3048;
+        for p in start {
+            let q = [p[0] + s * heading.cos(), p[1] + s * heading.sin()];
+            assert!(map.contains(q, heading, 1e-9), "{q:?}");
+        }
+        assert!(map.area_m2() > 0.04 && map.cw_rad > 0.02 && map.ccw_rad > 0.02);
+    }
+}
