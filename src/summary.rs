@@ -7,6 +7,16 @@ use std::path::Path;
 use anyhow::Context;
 use harvey_msgs::{MissionState, MissionStatus, TruePose, UncertaintyMap};
 
+/// One line of the summary: a labelled pose.
+fn pose_line(label: &str, p: &harvey_msgs::Pose2) -> String {
+    format!(
+        "  {label:<11} x {:7.3} m  y {:7.3} m  heading {:7.2} deg\n",
+        p.x_m,
+        p.y_m,
+        p.heading_rad.to_degrees()
+    )
+}
+
 /// What one topic of a recording holds.
 #[derive(Debug, Default, Clone)]
 pub struct TopicStats {
@@ -108,28 +118,13 @@ impl RunStats {
             s.header.stamp_ns as f64 / 1e9
         );
         let g = s.goal;
-        out += &format!(
-            "  goal        x {:7.3} m  y {:7.3} m  heading {:7.2} deg\n",
-            g.x_m,
-            g.y_m,
-            g.heading_rad.to_degrees()
-        );
+        out += &pose_line("goal", &g);
         let e = s.estimated;
-        out += &format!(
-            "  estimated   x {:7.3} m  y {:7.3} m  heading {:7.2} deg\n",
-            e.x_m,
-            e.y_m,
-            e.heading_rad.to_degrees()
-        );
+        out += &pose_line("estimated", &e);
         if let Some(t) = &self.last_truth {
             let p = t.world_from_robot;
             let err = (p.x_m - g.x_m).hypot(p.y_m - g.y_m);
-            out += &format!(
-                "  true        x {:7.3} m  y {:7.3} m  heading {:7.2} deg\n",
-                p.x_m,
-                p.y_m,
-                p.heading_rad.to_degrees()
-            );
+            out += &pose_line("true", &p);
             out += &format!("  final error {:.3} m ({:.2} in) from the goal\n", err, err / 0.0254);
         }
         if let Some(m) = &self.last_map {

@@ -135,10 +135,10 @@ impl Ums {
             self.run_started |= step.first_run;
             (self.travelled_m, self.turned_rad) = (o.travelled_m, o.turned_rad);
         }
-        let mut map = self.map.clone();
+        let mut map = std::mem::replace(&mut self.map, Map::exact(0.0, 0.0, 0.0));
         self.grow(&mut map, step);
-        self.map = map.clone();
-        self.history.push_back((o.header.stamp_ns, map, step));
+        self.history.push_back((o.header.stamp_ns, map.clone(), step));
+        self.map = map;
         while self.history.front().is_some_and(|(t, ..)| t + self.config.history_ns < o.header.stamp_ns) {
             self.history.pop_front();
         }

@@ -17,12 +17,21 @@ pub struct LineLandmarks {
     /// Bearing error of a recognised edge, in pixels.
     pub sd_px: f64,
     profile: Vec<f32>,
+    peaks: Vec<(usize, f32)>,
     seq: u64,
 }
 
 impl LineLandmarks {
     pub fn new(focal_px: f64, threshold: f32) -> Self {
-        Self { focal_px, threshold, dominance: 2.0, sd_px: 1.5, profile: Vec::new(), seq: 0 }
+        Self {
+            focal_px,
+            threshold,
+            dominance: 2.0,
+            sd_px: 1.5,
+            profile: Vec::new(),
+            peaks: Vec::new(),
+            seq: 0,
+        }
     }
 
     /// Looks for the landmark of `e` (class 1) in a mono8 or rgb8 frame. `None`: not a class I
@@ -51,14 +60,16 @@ impl LineLandmarks {
         }
         let rows = (v1 - v0) as f32;
         let p = &self.profile;
-        let peaks: Vec<(usize, f32)> = (0..p.len())
-            .filter(|&k| {
-                p[k] / rows > self.threshold
-                    && (k == 0 || p[k] >= p[k - 1])
-                    && (k + 1 == p.len() || p[k] > p[k + 1])
-            })
-            .map(|k| (k, p[k] / rows))
-            .collect();
+        self.peaks.clear();
+        self.peaks.extend(
+            (0..p.len())
+                .filter(|&k| {
+                    p[k] / rows > self.threshold
+                        && (k == 0 || p[k] >= p[k - 1])
+                        && (k + 1 == p.len() || p[k] > p[k + 1])
+                })
+                .map(|k| (k, p[k] / rows)),
+        );
         self.seq += 1;
         let header = Header::new(self.seq, h.stamp_ns);
         let base = LandmarkSighting {
@@ -67,6 +78,7 @@ impl LineLandmarks {
             landmark_index: e.landmark_index,
             ..Default::default()
         };
+        let peaks = &self.peaks;
         let best = peaks.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
         let Some((k, strength)) = best else {
             return Some(LandmarkSighting { kind: SightingKind::NotFound as u32, ..base });
