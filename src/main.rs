@@ -37,6 +37,8 @@ enum Cmd {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Compare the messages (topic, log time, payload) of two recordings; exit 1 if they differ.
+    Diff { a: PathBuf, b: PathBuf },
     /// Draw an MCAP recording into a Rerun file (`rerun run.rrd` opens it).
     Export {
         recording: PathBuf,
@@ -121,6 +123,10 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             print!("{}", summary::RunStats::read(&recording)?.info_table());
             Ok(0)
         }
+        Cmd::Diff { a, b } => {
+            let c = harvey_recorder::compare::compare(&a, &b, &|_| true)?;
+            Ok(report_comparison(&c, &a, &b))
+        }
         Cmd::Recover { recording, output } => {
             let s = harvey_recorder::recover::recover(&recording, &output)?;
             println!(
@@ -151,6 +157,20 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             }
             println!("{}: {drawn} messages drawn", output.display());
             Ok(0)
+        }
+    }
+}
+
+/// Prints the outcome of a comparison; the exit code is 0 when the recordings agree.
+fn report_comparison(c: &harvey_recorder::compare::Comparison, a: &Path, b: &Path) -> i32 {
+    match &c.first_difference {
+        None => {
+            println!("identical: {} messages of {} and {} agree", c.messages, a.display(), b.display());
+            0
+        }
+        Some(d) => {
+            println!("DIFFERENT at message {}: {}", d.index, d.detail);
+            1
         }
     }
 }

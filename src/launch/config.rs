@@ -31,6 +31,21 @@ pub struct Settings {
     pub grace_period_ms: u64,
     #[serde(default = "default_ready_ms")]
     pub ready_timeout_ms: u64,
+    /// `lockstep` (deterministic: ticks advance when every party has finished the last one) or
+    /// `realtime` (paced by the wall clock, for a real robot).
+    #[serde(default)]
+    pub clock: ClockMode,
+    /// Deterministic mode: the party that starts each tick.
+    pub clock_master: Option<Spanned<String>>,
+}
+
+/// How a launch keeps time (DESIGN.md, Time and determinism).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ClockMode {
+    Lockstep,
+    #[default]
+    Realtime,
 }
 
 fn default_seed() -> u64 {
@@ -80,6 +95,14 @@ pub struct Service {
     pub backoff_ms: u64,
     #[serde(default = "default_backoff_max_ms")]
     pub backoff_max_ms: u64,
+    /// Deterministic mode: whether this service takes turns in the clock chain (`false` for a
+    /// service on the far side of a serial line, like the simulated DRV).
+    #[serde(default = "default_true")]
+    pub clock_party: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 impl Service {
@@ -185,7 +208,37 @@ impl LaunchFile {
                 format!("key `launch.end_with`: no service is named `{}`", end.get_ref()),
             ));
         }
+        if parsed.launch.clock == ClockMode::Lockstep {
+            let Some(master) = &parsed.launch.clock_master else {
+                return Err(LaunchError {
+                    file,
+                    line: None,
+                    detail: "key `launch.clock`: lockstep needs `launch.clock_master`".into(),
+                });
+            };
+            if !parsed.services.iter().any(|s| s.clock_party && s.name() == master.get_ref()) {
+                return Err(at(
+                    master.span().start,
+                    format!(
+                        "key `launch.clock_master`: no service that is a clock party is named `{}`",
+                        master.get_ref()
+                    ),
+                ));
+            }
+        }
         Ok(Self { path: path.to_owned(), settings: parsed.launch, services: parsed.services })
+    }
+
+    /// Deterministic mode: the clock parties in turn order, from the master round to the tail.
+    pub fn clock_chain(&self) -> Vec<String> {
+        let (ClockMode::Lockstep, Some(master)) = (self.settings.clock, &self.settings.clock_master) else {
+            return Vec::new();
+        };
+        let mut chain: Vec<String> =
+            self.services.iter().filter(|s| s.clock_party).map(|s| s.name().to_owned()).collect();
+        let at = chain.iter().position(|n| n == master.get_ref()).unwrap_or(0);
+        chain.rotate_left(at);
+        chain
     }
 
     /// The world file, resolved against the launch file's folder.
@@ -217,6 +270,18 @@ mod tests {
         assert_eq!((l.services[0].restart, l.services[1].restart), (Restart::OnFailure, Restart::Never));
         assert_eq!(l.services[0].binary_name(), "harvey-a");
         assert_eq!(l.settings.seed, 1);
+    }
+
+    #[test]
+    fn the_clock_chain_starts_at_the_master_and_skips_non_parties() {
+        let text = "[launch]\nname = \"t\"\nclock = \"lockstep\"\nclock_master = \"c\"\n\n[[service]]\nname = \"a\"\n\n[[service]]\nname = \"b\"\nclock_party = false\n\n[[service]]\nname = \"c\"\n\n[[service]]\nname = \"d\"\n";
+        let l = parse(text).expect("parses");
+        assert_eq!(l.clock_chain(), ["c", "d", "a"]);
+        let e = parse(&text.replace("clock_master = \"c\"", "clock_master = \"b\"")).expect_err("not a party");
+        assert!(e.to_string().starts_with("m.toml:4: key `launch.clock_master`"), "{e}");
+        let e = parse(&text.replace("clock_master = \"c\"\n", "")).expect_err("no master");
+        assert!(e.to_string().contains("lockstep needs `launch.clock_master`"), "{e}");
+        assert!(parse(OK).expect("parses").clock_chain().is_empty(), "real time has no chain");
     }
 
     #[test]

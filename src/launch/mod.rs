@@ -1,6 +1,7 @@
 //! `harvey launch`: launch files and the supervisor that runs them.
 
 mod child;
+mod clock;
 pub mod config;
 pub mod supervisor;
 

@@ -10,7 +10,8 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 
 use super::child::{self, Running, describe};
-use super::config::{LaunchFile, Restart, Service};
+use super::clock::ClockWatch;
+use super::config::{ClockMode, LaunchFile, Restart, Service};
 
 /// How a launch ended.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -45,6 +46,8 @@ struct Slot {
     spec: Service,
     binary: PathBuf,
     args: Vec<String>,
+    /// The bus domain, and the service's place in the clock chain.
+    env: Vec<(&'static str, String)>,
     running: Option<Running>,
     /// Exit times inside the restart window.
     failures: Vec<Instant>,
@@ -92,9 +95,23 @@ pub fn run(launch: &LaunchFile, opts: &Options) -> anyhow::Result<Outcome> {
         );
         vars.push(("world", absolute(&w).display().to_string()));
     }
+    let chain = launch.clock_chain();
+    let clock_mode = match launch.settings.clock {
+        ClockMode::Lockstep => "lockstep",
+        ClockMode::Realtime => "realtime",
+    };
     // Check every binary before starting anything.
     let mut slots = Vec::new();
     for s in &launch.services {
+        let mut env = vec![
+            (harvey_bus::PREFIX_ENV, opts.prefix.clone()),
+            (harvey_bus::CLOCK_ENV, clock_mode.to_owned()),
+        ];
+        if let Some(i) = chain.iter().position(|p| p == s.name()) {
+            let after = &chain[(i + chain.len() - 1) % chain.len()];
+            env.push((harvey_bus::PARTY_ENV, s.name().to_owned()));
+            env.push((harvey_bus::AFTER_ENV, after.clone()));
+        }
         let bin = s.binary_name();
         let binary = find_binary(&bin).with_context(|| {
             format!("{}: service `{}`: executable `{bin}` not found beside harvey or on PATH (build it with `cargo build --release --workspace`)", launch.path.display(), s.name())
@@ -104,6 +121,7 @@ pub fn run(launch: &LaunchFile, opts: &Options) -> anyhow::Result<Outcome> {
             spec: s.clone(),
             binary,
             args,
+            env,
             running: None,
             failures: Vec::new(),
             restart_at: None,
@@ -130,7 +148,7 @@ pub fn run(launch: &LaunchFile, opts: &Options) -> anyhow::Result<Outcome> {
         signal_hook::flag::register_usize(sig, Arc::clone(&signals), sig as usize)
             .context("installing signal handlers")?;
     }
-    let env = [(harvey_bus::PREFIX_ENV, opts.prefix.clone())];
+    let mut clock = if chain.is_empty() { None } else { Some(ClockWatch::new(&opts.prefix, &chain)?) };
     let ready = Duration::from_millis(launch.settings.ready_timeout_ms);
     let grace = Duration::from_millis(launch.settings.grace_period_ms);
 
@@ -139,13 +157,17 @@ pub fn run(launch: &LaunchFile, opts: &Options) -> anyhow::Result<Outcome> {
             if signals.load(Ordering::Relaxed) != 0 {
                 return Ok(Outcome::Interrupted);
             }
-            let r = child::spawn(slot.spec.name(), &slot.binary, &slot.args, &env, ready)?;
+            let r = child::spawn(slot.spec.name(), &slot.binary, &slot.args, &slot.env, ready)?;
             tracing::info!(service = %r.name, pid = r.child.id(), "ready");
             slot.running = Some(r);
         }
-        supervise(&mut slots, launch, &env, ready, &signals)
+        if let Some(c) = &mut clock {
+            c.start()?;
+        }
+        supervise(&mut slots, launch, &opts.prefix, clock.as_mut(), ready, &signals)
     })();
     shutdown(&mut slots, grace);
+    drop(clock);
     match harvey_bus::retire_domain(&opts.prefix) {
         Ok(n) => tracing::debug!(removed = n, "bus domain retired"),
         Err(e) => tracing::warn!("bus domain not retired: {e}"),
@@ -156,13 +178,16 @@ pub fn run(launch: &LaunchFile, opts: &Options) -> anyhow::Result<Outcome> {
 fn supervise(
     slots: &mut [Slot],
     launch: &LaunchFile,
-    env: &[(&str, String)],
+    prefix: &str,
+    mut clock: Option<&mut ClockWatch>,
     ready: Duration,
     signals: &AtomicUsize,
 ) -> anyhow::Result<Outcome> {
     let end_with = launch.settings.end_with.as_ref().map(|s| s.get_ref().clone());
-    let prefix = &env[0].1;
     loop {
+        if let Some(c) = clock.as_deref_mut() {
+            c.poll()?;
+        }
         if signals.load(Ordering::Relaxed) != 0 {
             tracing::info!("signal received: stopping");
             return Ok(Outcome::Interrupted);
@@ -203,10 +228,13 @@ fn supervise(
             if slot.restart_at.is_some_and(|t| t <= now) {
                 slot.restart_at = None;
                 let cleaned = harvey_bus::cleanup_dead_nodes(prefix)?;
-                match child::spawn(slot.spec.name(), &slot.binary, &slot.args, env, ready) {
+                match child::spawn(slot.spec.name(), &slot.binary, &slot.args, &slot.env, ready) {
                     Ok(r) => {
                         tracing::info!(service = %r.name, pid = r.child.id(), cleaned, "restarted");
                         slot.running = Some(r);
+                        if let Some(c) = clock.as_deref_mut() {
+                            c.resume(slot.spec.name())?;
+                        }
                     }
                     Err(e) => {
                         tracing::error!("{e:#}");

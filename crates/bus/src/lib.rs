@@ -8,13 +8,17 @@
 //!   publisher notifies after each send, so subscribers sleep in a [`Waiter`] instead of polling.
 //! - Frames are `[u8]` slices with a [`harvey_msgs::FrameHeader`]: the producer writes pixels
 //!   straight into the loaned shared-memory slice, the consumer reads them in place.
+//! - [`Pace`] runs a service's loop on its inputs (real time) or on its turn in the clock chain
+//!   of deterministic mode ([`Lockstep`]).
 
+mod clock;
 mod domain;
 mod error;
 mod frames;
 mod pubsub;
 mod waiter;
 
+pub use clock::{AFTER_ENV, CLOCK_ENV, Lockstep, PARTY_ENV, Pace, Step, lockstep_from_env};
 pub use domain::{
     Bus, DEFAULT_PREFIX, NodeInfo, PREFIX_ENV, cleanup_dead_nodes, live_nodes, retire_domain, validate_prefix,
 };

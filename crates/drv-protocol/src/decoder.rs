@@ -115,6 +115,8 @@ mod tests {
             }),
             Line::Report(Report::Ack { id: 3 }),
             Line::Report(Report::Nak { id: 4, reason: crate::NakReason::OutOfRange }),
+            Line::Tick { time_ms: 1_250 },
+            Line::Sync { time_ms: 1_250 },
         ]
     }
 
@@ -123,7 +125,7 @@ mod tests {
         let bytes: String = samples().iter().map(encode).collect();
         let (lines, stats) = decode_all(bytes.as_bytes());
         assert_eq!(lines, samples());
-        assert_eq!(stats, DecoderStats { frames: 8, ..DecoderStats::default() });
+        assert_eq!(stats, DecoderStats { frames: 10, ..DecoderStats::default() });
     }
 
     #[test]

@@ -51,6 +51,12 @@ pub enum NakReason {
 pub enum Line {
     Command(Command),
     Report(Report),
+    /// DRV → host, deterministic mode only (a Harvey extension; see `docs/drv-protocol.md`):
+    /// every report of the tick ending at `time_ms` has been sent.
+    Tick { time_ms: u64 },
+    /// Host → DRV, deterministic mode only: every command of the tick ending at `time_ms` has
+    /// been sent; the DRV may simulate the next tick.
+    Sync { time_ms: u64 },
 }
 
 /// What is wrong with a received frame.
@@ -98,6 +104,8 @@ pub fn encode(line: &Line) -> String {
             ranges_tenths_ft.iter().try_for_each(|r| write!(body, " {r}"))
         }
         Line::Report(Report::Ack { id }) => write!(body, "AK {id}"),
+        Line::Tick { time_ms } => write!(body, "TK {time_ms}"),
+        Line::Sync { time_ms } => write!(body, "SY {time_ms}"),
         Line::Report(Report::Nak { id, reason }) => write!(
             body,
             "NK {id} {}",
@@ -197,6 +205,14 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
                     .ok_or_else(|| bad("`SN` range above 255"))?;
             }
             Line::Report(Report::Sonar { time_ms: time(0)?, bank, ranges_tenths_ft })
+        }
+        "TK" => {
+            arity(1)?;
+            Line::Tick { time_ms: time(0)? }
+        }
+        "SY" => {
+            arity(1)?;
+            Line::Sync { time_ms: time(0)? }
         }
         "AK" => {
             arity(1)?;

@@ -41,6 +41,16 @@ pub struct TruePose {
 }
 message!(TruePose);
 
+/// Deterministic mode: a party of the clock chain has finished every tick up to
+/// `header.stamp_ns` (see `topics::clock_progress`). `header.seq` counts its turns.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/Progress")]
+pub struct Progress {
+    pub header: Header,
+}
+message!(Progress);
+
 /// One bank of sonar readings as the DRV reported them, converted to metres by the bridge.
 #[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
 #[repr(C)]

@@ -3,8 +3,8 @@
 use core::marker::PhantomData;
 
 use crate::{
-    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, SonarRaw,
-    SonarRing, TruePose, UncertaintyMap,
+    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, Progress,
+    SonarRaw, SonarRing, TruePose, UncertaintyMap,
 };
 
 /// Queue sizing of a topic. Every process opening the topic uses the same numbers, so the
@@ -28,6 +28,9 @@ impl Qos {
     /// 3 subscribers x (2 queued + 1 held) + 1 loaned = 10 frames (62 MB at 1080p rgb8,
     /// 3 MB at 640x480 mono8).
     pub const FRAMES: Qos = Qos { buffer: 2, borrowed: 1, history: 0, max_publishers: 1, max_subscribers: 3 };
+    /// A clock party's progress: read by its successor, the clock master and the supervisor
+    /// (which also publishes, to start the chain and to resume it after a restart).
+    pub const CLOCK: Qos = Qos { buffer: 8, borrowed: 1, history: 0, max_publishers: 2, max_subscribers: 4 };
 }
 
 /// A typed topic of fixed-size messages.
@@ -70,6 +73,14 @@ pub const VISION_SIGHTINGS: Topic<LandmarkSighting> = Topic::new("vision/sightin
 pub const UMS_EXPECTATIONS: Topic<Expectation> = Topic::new("ums/expectations", Qos::STATE);
 pub const EXECUTIVE_STATUS: Topic<MissionStatus> = Topic::new("executive/status", Qos::STATE);
 pub const CAMERA_FRAME: FrameTopic = FrameTopic { name: "camera/frame", qos: Qos::FRAMES };
+
+/// The progress topic of clock party `party` (deterministic mode), `clock/<party>`: bus
+/// plumbing, not data, so it is not in [`ALL`] and is not recorded. The name is leaked: call
+/// this once per party at start-up, not per message.
+pub fn clock_progress(party: &str) -> Topic<Progress> {
+    let name: &'static str = Box::leak(format!("clock/{party}").into_boxed_str());
+    Topic::new(name, Qos::CLOCK)
+}
 
 /// Every topic's name; the recorder must record each of them.
 pub const ALL: &[&str] = &[

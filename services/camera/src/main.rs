@@ -8,7 +8,7 @@ use std::time::Duration;
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, FramePublisher, Waiter, Wake};
+use harvey_bus::{Bus, FramePublisher, Pace, Step, Waiter, Wake};
 use harvey_camera::{Effects, Renderer, checksum};
 use harvey_msgs::{Encoding, FrameHeader, topics};
 use harvey_world::World;
@@ -147,16 +147,18 @@ fn main() -> anyhow::Result<()> {
     }
 
     let truth = bus.subscriber(topics::SIM_TRUTH)?;
-    let _a = waiter.attach(&truth)?;
+    let pace = Pace::from_env(&bus)?;
+    let _a = pace.attach(&waiter, &[&truth])?;
     harvey_runtime::notify_ready()?;
     let every = args.every.max(1);
     let mut poses = Vec::new();
-    while waiter.wait(None)? != Wake::Shutdown {
+    while pace.next(&waiter, None)? != Step::Stop {
         truth.drain_into(&mut poses)?;
         for t in poses.iter().filter(|t| t.header.seq % every == 0) {
             let p = t.world_from_robot;
             cam.shoot([p.x_m, p.y_m, p.heading_rad], t.header.stamp_ns)?;
         }
+        pace.done()?;
     }
     tracing::info!(frames = cam.seq, "camera stopped");
     Ok(())

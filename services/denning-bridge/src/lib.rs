@@ -115,6 +115,10 @@ pub enum Outgoing {
     Accepted {
         id: u32,
     },
+    /// Deterministic mode: the DRV has sent every report of the tick ending at `time_ms`.
+    Tick {
+        time_ms: u64,
+    },
 }
 
 /// Report → message converter; numbers each output topic's messages.

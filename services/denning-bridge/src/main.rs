@@ -7,7 +7,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, FdSource, Waiter, Wake};
+use harvey_bus::{Bus, FdSource, Lockstep, Waiter, Wake};
 use harvey_denning_bridge::{Bridge, Outgoing, PanicLatch, prioritise, to_drv};
 use harvey_drv_protocol::serial::{make_raw, read_available, write_frame};
 use harvey_drv_protocol::{Decoder, Line, encode};
@@ -39,33 +39,49 @@ fn main() -> anyhow::Result<()> {
     let commands = bus.subscriber(topics::VEHICLE_COMMAND)?;
     let encoders = bus.publisher(topics::DRV_ENCODERS_RAW)?;
     let sonar = bus.publisher(topics::DRV_SONAR_RAW)?;
+    // Deterministic mode: the bridge is the clock master on the bus. A tick's turn starts when
+    // the DRV's `TK` closes its reports; when the chain's tail has finished the tick, the
+    // tick's commands go out, closed by `SY`.
+    let lockstep = Lockstep::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let line_source = FdSource::new(&port)?;
-    let _a = waiter.attach(&commands)?;
+    let _a = match &lockstep {
+        Some(l) => waiter.attach(l.predecessor())?,
+        None => waiter.attach(&commands)?,
+    };
     let _b = waiter.attach(&line_source)?;
     harvey_runtime::notify_ready()?;
-    tracing::info!(device = %args.device.display(), "bridge up");
+    tracing::info!(device = %args.device.display(), lockstep = lockstep.is_some(), "bridge up");
 
     let mut bridge = Bridge::default();
     let mut latch = PanicLatch::new(args.panic_hold_ms * 1_000_000);
     let mut decoder = Decoder::new();
-    let mut buf = Vec::new();
-    let mut batch = Vec::new();
-    loop {
-        if waiter.wait(None)? == Wake::Shutdown {
-            break;
-        }
+    let (mut buf, mut batch, mut ticks) = (Vec::new(), Vec::new(), Vec::new());
+    let mut forward = |port: &mut std::fs::File| -> anyhow::Result<()> {
         batch.clear();
         commands.drain(|c| batch.push(*c))?;
         for cmd in prioritise(&batch) {
             match latch.admit(&cmd).and_then(|()| to_drv(&cmd)) {
-                Ok(drv) => {
-                    if !write_frame(&mut port, encode(&Line::Command(drv)).as_bytes())? {
-                        tracing::error!(?drv, "serial line full: command not sent");
-                    }
-                }
+                Ok(drv) => send(port, &Line::Command(drv))?,
                 Err(refusal) => tracing::error!("refused: {refusal}"),
             }
+        }
+        Ok(())
+    };
+    loop {
+        if waiter.wait(None)? == Wake::Shutdown {
+            break;
+        }
+        match &lockstep {
+            Some(l) => {
+                ticks.clear();
+                l.finished(|t| ticks.push(t))?;
+                for &t in &ticks {
+                    forward(&mut port)?;
+                    send(&mut port, &Line::Sync { time_ms: t / 1_000_000 })?;
+                }
+            }
+            None => forward(&mut port)?,
         }
         if !read_available(&mut port, &mut buf).context("reading the DRV line")? {
             anyhow::bail!("the DRV line {} hung up", args.device.display());
@@ -73,7 +89,10 @@ fn main() -> anyhow::Result<()> {
         let mut out = Vec::new();
         decoder.push(&buf, |frame| match frame {
             Ok(Line::Report(r)) => out.push(bridge.on_report(r)),
-            Ok(Line::Command(c)) => tracing::warn!(?c, "ignoring a command echoed by the vehicle"),
+            Ok(Line::Tick { time_ms }) => out.push(Outgoing::Tick { time_ms }),
+            Ok(line @ (Line::Command(_) | Line::Sync { .. })) => {
+                tracing::warn!(?line, "ignoring a host frame echoed by the vehicle")
+            }
             Err(e) => tracing::warn!("bad frame from the DRV: {e}"),
         });
         for o in out {
@@ -84,6 +103,10 @@ fn main() -> anyhow::Result<()> {
                 Outgoing::Sonar(m) => {
                     sonar.send(&m)?;
                 }
+                Outgoing::Tick { time_ms } => match &lockstep {
+                    Some(l) => l.finish(time_ms * 1_000_000)?,
+                    None => tracing::warn!(time_ms, "a tick mark from the DRV in real-time mode"),
+                },
                 Outgoing::Refused { id, reason } => {
                     tracing::error!(id, ?reason, "the DRV refused a command")
                 }
@@ -92,5 +115,13 @@ fn main() -> anyhow::Result<()> {
         }
     }
     tracing::info!(stats = ?decoder.stats(), "bridge stopped");
+    Ok(())
+}
+
+/// Writes one frame to the DRV; a full line loses it, loudly.
+fn send(port: &mut std::fs::File, line: &Line) -> anyhow::Result<()> {
+    if !write_frame(port, encode(line).as_bytes())? {
+        tracing::error!(?line, "serial line full: frame not sent");
+    }
     Ok(())
 }

@@ -1,6 +1,6 @@
 //! harvey-encoders: DRV shaft-encoder reports and motion commands in, odometry out.
 
-use harvey_bus::{Bus, Waiter, Wake};
+use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_encoders::OdometryBuilder;
 use harvey_msgs::topics;
 
@@ -10,14 +10,14 @@ fn main() -> anyhow::Result<()> {
     let raw = bus.subscriber(topics::DRV_ENCODERS_RAW)?;
     let commands = bus.subscriber(topics::VEHICLE_COMMAND)?;
     let odometry = bus.publisher(topics::ODOMETRY)?;
+    let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = waiter.attach(&raw)?;
-    let _b = waiter.attach(&commands)?;
+    let _a = pace.attach(&waiter, &[&raw, &commands])?;
     harvey_runtime::notify_ready()?;
 
     let mut builder = OdometryBuilder::default();
     let (mut reports, mut cmds) = (Vec::new(), Vec::new());
-    while waiter.wait(None)? != Wake::Shutdown {
+    while pace.next(&waiter, None)? != Step::Stop {
         commands.drain_into(&mut cmds)?;
         cmds.iter().for_each(|c| builder.on_command(c));
         raw.drain_into(&mut reports)?;
@@ -29,6 +29,7 @@ fn main() -> anyhow::Result<()> {
                 Err(e) => tracing::warn!("dropping an encoder report: {e}"),
             }
         }
+        pace.done()?;
     }
     Ok(())
 }

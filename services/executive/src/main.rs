@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, Waiter, Wake};
+use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_executive::{Executive, Output, mission};
 use harvey_msgs::{MissionState, topics};
 
@@ -33,17 +33,15 @@ fn main() -> anyhow::Result<()> {
     let maps = bus.subscriber(topics::UMS_MAP)?;
     let commands = bus.publisher(topics::VEHICLE_COMMAND)?;
     let status = bus.publisher(topics::EXECUTIVE_STATUS)?;
+    let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = waiter.attach(&odometry)?;
-    let _b = waiter.attach(&sonar)?;
-    let _c = waiter.attach(&detections)?;
-    let _d = waiter.attach(&maps)?;
+    let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps])?;
     harvey_runtime::notify_ready()?;
 
     let mut exec = Executive::new(mission);
     let mut odos = Vec::new();
     while exec.state() == MissionState::Running {
-        if waiter.wait(None)? == Wake::Shutdown {
+        if pace.next(&waiter, None)? == Step::Stop {
             tracing::warn!("stopped before the mission ended");
             return Ok(());
         }
@@ -70,6 +68,7 @@ fn main() -> anyhow::Result<()> {
                 }
             }
         }
+        pace.done()?;
     }
     match exec.state() {
         MissionState::Succeeded => {

@@ -8,6 +8,7 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
+pub mod compare;
 pub mod draw;
 pub mod export;
 pub mod recover;

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, FrameSubscriber, Subscriber, Waitable, Waiter, Wake};
+use harvey_bus::{Bus, FrameSubscriber, Pace, Step, Subscriber, Waitable, Waiter};
 use harvey_cdr::Ros2Msg;
 use harvey_msgs::{Message, Topic, topics};
 use harvey_recorder::draw::Draw;
@@ -35,6 +35,18 @@ struct Args {
 struct Sinks {
     mcap: Recorder,
     rrd: Option<RrdWriter>,
+    /// Deterministic mode: messages stamped after this belong to a tick the chain never
+    /// finished (the launch stopped inside it) and are left out.
+    until_ns: u64,
+    left_out: u64,
+}
+
+impl Sinks {
+    fn admits(&mut self, stamp_ns: u64) -> bool {
+        let keep = stamp_ns <= self.until_ns;
+        self.left_out += u64::from(!keep);
+        keep
+    }
 }
 
 /// A subscribed topic feeding a channel.
@@ -55,10 +67,10 @@ impl<T: Message + Ros2Msg + Draw> Tap for MsgTap<T> {
     fn drain(&self, out: &mut Sinks) -> anyhow::Result<usize> {
         let mut written = Ok(());
         let n = self.sub.drain(|m| {
-            if written.is_ok() {
+            if written.is_ok() && out.admits(m.header().stamp_ns) {
                 written = out.mcap.record(self.channel, m);
             }
-            if let (Ok(()), Some(rrd)) = (&written, out.rrd.as_mut()) {
+            if let (Ok(()), Some(rrd), true) = (&written, out.rrd.as_mut(), m.header().stamp_ns <= out.until_ns) {
                 written = m.draw(rrd);
             }
         })?;
@@ -79,6 +91,9 @@ impl Tap for FrameTap {
     fn drain(&self, out: &mut Sinks) -> anyhow::Result<usize> {
         let mut n = 0;
         while let Some(frame) = self.sub.take()? {
+            if !out.admits(frame.header().stamp_ns) {
+                continue;
+            }
             out.mcap.record_frame(self.channel, frame.header(), frame.pixels())?;
             if let Some(rrd) = out.rrd.as_mut() {
                 rrd.frame(frame.header(), frame.pixels())?;
@@ -133,21 +148,37 @@ fn main() -> anyhow::Result<()> {
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();
     let missing: Vec<&&str> = topics::ALL.iter().filter(|t| !recorded.contains(t)).collect();
     anyhow::ensure!(missing.is_empty(), "the recorder has no tap for {missing:?}");
-    let mut sinks = Sinks { mcap: rec, rrd };
+    let mut sinks = Sinks { mcap: rec, rrd, until_ns: u64::MAX, left_out: 0 };
 
+    let pace = Pace::from_env(&bus)?;
+    let lockstep = pace.lockstep().is_some();
     let waiter = Waiter::new()?;
     let waitables: Vec<&dyn Waitable> = taps.iter().map(|t| t.waitable()).collect();
-    let _attached = waitables.iter().map(|w| waiter.attach(*w)).collect::<Result<Vec<_>, _>>()?;
+    let _attached = pace.attach(&waiter, &waitables)?;
     harvey_runtime::notify_ready()?;
-    tracing::info!(output = %args.output.display(), topics = taps.len(), "recording");
+    tracing::info!(output = %args.output.display(), topics = taps.len(), lockstep, "recording");
 
     let flush_every = Duration::from_millis(args.flush_ms.max(1));
     let mut last_flush = Instant::now();
+    let mut last_turn: Option<Instant> = None;
     loop {
-        let wake = waiter.wait(Some(flush_every))?;
-        for t in &taps {
-            t.drain(&mut sinks)?;
+        let step = pace.next(&waiter, Some(flush_every))?;
+        if let Step::Go(Some(tick)) = step {
+            sinks.until_ns = tick;
+            // Wall time the whole chain took for this tick: the loop latency plot.
+            let now = Instant::now();
+            if let (Some(at), Some(rrd)) = (last_turn, sinks.rrd.as_mut()) {
+                rrd.loop_latency(tick, now.duration_since(at).as_secs_f64() * 1e3)?;
+            }
+            last_turn = Some(now);
         }
+        // In deterministic mode an idle wake-up must not take a tick still under way.
+        if !(lockstep && step == Step::Idle) {
+            for t in &taps {
+                t.drain(&mut sinks)?;
+            }
+        }
+        pace.done()?;
         if last_flush.elapsed() >= flush_every {
             sinks.mcap.flush()?;
             if let Some(rrd) = &sinks.rrd {
@@ -155,7 +186,7 @@ fn main() -> anyhow::Result<()> {
             }
             last_flush = Instant::now();
         }
-        if wake == Wake::Shutdown {
+        if step == Step::Stop {
             break;
         }
     }
@@ -166,6 +197,6 @@ fn main() -> anyhow::Result<()> {
     }
     let total: u64 = stats.iter().map(|s| s.messages).sum();
     let gaps: u64 = stats.iter().map(|s| s.seq_gaps).sum();
-    tracing::info!(messages = total, seq_gaps = gaps, output = %args.output.display(), "recording finished");
+    tracing::info!(messages = total, seq_gaps = gaps, left_out = sinks.left_out, output = %args.output.display(), "recording finished");
     Ok(())
 }

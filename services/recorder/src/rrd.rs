@@ -38,6 +38,8 @@ pub struct RrdWriter {
     path: String,
     pose: Option<[f64; 3]>,
     last_state: Option<(u32, u32)>,
+    /// The executive's current goal: the line the servo deviation is measured from.
+    goal: Option<harvey_msgs::Pose2>,
     /// (focal, width, height) of the camera, to draw sightings' bearings on the image.
     camera: Option<(f64, f64, f64)>,
     /// Stamp of each landmark's latest Expecter window: windows not renewed are cleared.
@@ -74,6 +76,7 @@ impl RrdWriter {
             path: path.display().to_string(),
             pose: None,
             last_state: None,
+            goal: None,
             camera,
             windows: Default::default(),
         };
@@ -111,7 +114,19 @@ impl RrdWriter {
     pub fn truth(&mut self, m: &TruePose) -> Result<(), RecordError> {
         self.at(m.header.stamp_ns);
         let arrow = pose_arrow(&m.world_from_robot, rerun::Color::from_rgb(60, 200, 60));
-        self.rec.log("world/truth", &arrow).map_err(|e| self.err(e))
+        self.rec.log("world/truth", &arrow).map_err(|e| self.err(e))?;
+        // Servo deviation: how far the true robot is off the line it is driving, the line
+        // through the executive's current goal along the goal's heading (positive: left of it).
+        let Some(g) = self.goal else { return Ok(()) };
+        let p = m.world_from_robot;
+        let off = -(p.x_m - g.x_m) * g.heading_rad.sin() + (p.y_m - g.y_m) * g.heading_rad.cos();
+        self.rec.log("plots/servo_deviation_m", &rerun::Scalars::single(off)).map_err(|e| self.err(e))
+    }
+
+    /// Deterministic mode: the wall time every service together took for the tick at `stamp_ns`.
+    pub fn loop_latency(&mut self, stamp_ns: u64, wall_ms: f64) -> Result<(), RecordError> {
+        self.at(stamp_ns);
+        self.rec.log("plots/loop_latency_ms", &rerun::Scalars::single(wall_ms)).map_err(|e| self.err(e))
     }
 
     pub fn odometry(&mut self, m: &Odometry) -> Result<(), RecordError> {
@@ -253,6 +268,7 @@ impl RrdWriter {
 
     /// The executive's status, logged when its state or step changes.
     pub fn status(&mut self, s: &MissionStatus) -> Result<(), RecordError> {
+        self.goal = Some(s.goal);
         if self.last_state == Some((s.state, s.step)) {
             return Ok(());
         }

@@ -60,41 +60,71 @@ fn main() -> anyhow::Result<()> {
     harvey_runtime::notify_ready()?;
     tracing::info!(pty = %args.pty.display(), tty = %slave_path.display(), seed = args.seed, "simulated DRV up");
 
+    // Deterministic mode: no timer; each `SY` from the bridge (after the tick's commands)
+    // releases the next tick. Real time: a tick every `tick_ms / speedup` of wall time.
+    let lockstep = harvey_bus::lockstep_from_env();
     let period = Duration::from_secs_f64(args.tick_ms as f64 / 1000.0 / args.speedup);
     let mut next_tick = Instant::now() + period;
     let mut decoder = Decoder::new();
-    let mut buf = Vec::new();
+    let (mut buf, mut lines) = (Vec::new(), Vec::new());
     let mut dropped_frames = 0u64;
+    let mut send = |line: &mut File, l: &Line| -> anyhow::Result<()> {
+        dropped_frames += u64::from(!write_frame(line, encode(l).as_bytes())?);
+        Ok(())
+    };
     loop {
         let now = Instant::now();
-        if now < next_tick && waiter.wait(Some(next_tick - now))? == Wake::Shutdown {
+        let timeout = (!lockstep).then(|| next_tick.saturating_duration_since(now));
+        if (lockstep || now < next_tick) && waiter.wait(timeout)? == Wake::Shutdown {
             break;
         }
         read_available(&mut line, &mut buf).context("reading the pseudo-terminal")?;
-        let mut replies = Vec::new();
+        lines.clear();
         decoder.push(&buf, |frame| match frame {
-            Ok(Line::Command(cmd)) => replies.push(sim.handle(cmd)),
-            Ok(Line::Report(r)) => tracing::warn!(?r, "ignoring a report sent to the DRV"),
+            Ok(l) => lines.push(l),
             Err(e) => tracing::warn!("bad frame from the host: {e}"),
         });
-        for r in replies {
-            dropped_frames += u64::from(!write_frame(&mut line, encode(&Line::Report(r)).as_bytes())?);
-        }
-        if Instant::now() >= next_tick {
-            next_tick += period;
-            let out = sim.tick();
-            for r in &out.reports {
-                dropped_frames += u64::from(!write_frame(&mut line, encode(&Line::Report(*r)).as_bytes())?);
+        let mut due = !lockstep && Instant::now() >= next_tick;
+        for l in &lines {
+            match *l {
+                Line::Command(cmd) => send(&mut line, &Line::Report(sim.handle(cmd)))?,
+                Line::Sync { time_ms } if lockstep => {
+                    if time_ms != sim.time_ms() {
+                        tracing::warn!(time_ms, sim_ms = sim.time_ms(), "SY for another tick");
+                    }
+                    due = true;
+                }
+                other => tracing::warn!(?other, "ignoring a frame the DRV does not take here"),
             }
-            let stamp_ns = out.time_ms * 1_000_000;
-            let pose = Pose2 { x_m: out.truth.x, y_m: out.truth.y, heading_rad: out.truth.th };
-            truth_pub.send(&TruePose {
-                header: Header::new(stamp_ns / (args.tick_ms * 1_000_000), stamp_ns),
-                world_from_robot: pose,
-            })?;
+            if due && lockstep {
+                tick(&mut sim, &truth_pub, args.tick_ms, |l| send(&mut line, l))?;
+                send(&mut line, &Line::Tick { time_ms: sim.time_ms() })?;
+                due = false;
+            }
+        }
+        if due {
+            next_tick += period;
+            tick(&mut sim, &truth_pub, args.tick_ms, |l| send(&mut line, l))?;
         }
     }
     let _ = std::fs::remove_file(&args.pty);
     tracing::info!(time_ms = sim.time_ms(), dropped_frames, stats = ?decoder.stats(), "simulated DRV stopped");
     Ok(())
+}
+
+/// Simulates one tick: the truth goes to the bus, the reports down the line.
+fn tick(
+    sim: &mut SimDrv,
+    truth_pub: &harvey_bus::Publisher<TruePose>,
+    tick_ms: u64,
+    mut send: impl FnMut(&Line) -> anyhow::Result<()>,
+) -> anyhow::Result<()> {
+    let out = sim.tick();
+    let stamp_ns = out.time_ms * 1_000_000;
+    let pose = Pose2 { x_m: out.truth.x, y_m: out.truth.y, heading_rad: out.truth.th };
+    truth_pub.send(&TruePose {
+        header: Header::new(stamp_ns / (tick_ms * 1_000_000), stamp_ns),
+        world_from_robot: pose,
+    })?;
+    out.reports.iter().try_for_each(|r| send(&Line::Report(*r)))
 }

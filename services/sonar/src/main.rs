@@ -2,7 +2,7 @@
 //! straight to the vehicle.
 
 use clap::Parser;
-use harvey_bus::{Bus, Waiter, Wake};
+use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::topics;
 use harvey_sonar::SonarRingBuilder;
 
@@ -21,14 +21,15 @@ fn main() -> anyhow::Result<()> {
     let raw = bus.subscriber(topics::DRV_SONAR_RAW)?;
     let ring_pub = bus.publisher(topics::SONAR_RING)?;
     let stop_pub = bus.publisher(topics::VEHICLE_COMMAND)?;
+    let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = waiter.attach(&raw)?;
+    let _a = pace.attach(&waiter, &[&raw])?;
     harvey_runtime::notify_ready()?;
 
     let mut ring = SonarRingBuilder::new(args.panic_stop_ft * 0.3048);
     let mut banks = Vec::new();
     let mut rings = 0u64;
-    while waiter.wait(None)? != Wake::Shutdown {
+    while pace.next(&waiter, None)? != Step::Stop {
         raw.drain_into(&mut banks)?;
         for bank in &banks {
             match ring.on_bank(bank) {
@@ -42,6 +43,7 @@ fn main() -> anyhow::Result<()> {
                 Err(e) => tracing::warn!("dropping a sonar report: {e}"),
             }
         }
+        pace.done()?;
     }
     tracing::info!(rings, "sonar stopped");
     Ok(())

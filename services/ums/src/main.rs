@@ -4,7 +4,7 @@
 use std::path::PathBuf;
 
 use clap::Parser;
-use harvey_bus::{Bus, Waiter, Wake};
+use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::topics;
 use harvey_ums::{Config, Output, Ums};
 
@@ -49,14 +49,14 @@ fn main() -> anyhow::Result<()> {
     let sightings = bus.subscriber(topics::VISION_SIGHTINGS)?;
     let map_pub = bus.publisher(topics::UMS_MAP)?;
     let expectations = bus.publisher(topics::UMS_EXPECTATIONS)?;
+    let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = waiter.attach(&odometry)?;
-    let _b = waiter.attach(&sightings)?;
+    let _a = pace.attach(&waiter, &[&odometry, &sightings])?;
     harvey_runtime::notify_ready()?;
 
     let mut ums = Ums::new(world, config);
     let (mut odos, mut seen) = (Vec::new(), Vec::new());
-    while waiter.wait(None)? != Wake::Shutdown {
+    while pace.next(&waiter, None)? != Step::Stop {
         sightings.drain_into(&mut seen)?;
         for s in &seen {
             if let Err(e) = ums.on_sighting(s) {
@@ -77,6 +77,7 @@ fn main() -> anyhow::Result<()> {
                 Err(e) => tracing::warn!("rejected: {e}"),
             }
         }
+        pace.done()?;
     }
     Ok(())
 }

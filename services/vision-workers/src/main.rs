@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use clap::Parser;
-use harvey_bus::{Bus, Waiter, Wake};
+use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::{Expectation, topics};
 use harvey_vision_workers::VerticalEdges;
 use harvey_vision_workers::landmarks::LineLandmarks;
@@ -40,9 +40,9 @@ fn main() -> anyhow::Result<()> {
     let expectations = bus.subscriber(topics::UMS_EXPECTATIONS)?;
     let detections = bus.publisher(topics::VISION_DETECTIONS)?;
     let sightings = bus.publisher(topics::VISION_SIGHTINGS)?;
+    let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = waiter.attach(&frames)?;
-    let _b = waiter.attach(&expectations)?;
+    let _a = pace.attach(&waiter, &[&frames, &expectations])?;
     harvey_runtime::notify_ready()?;
 
     let mut edges = VerticalEdges::new(args.band_half_rows, args.edge_threshold);
@@ -50,12 +50,15 @@ fn main() -> anyhow::Result<()> {
     let mut wanted: BTreeMap<u32, Expectation> = BTreeMap::new();
     let max_age_ns = args.expectation_max_age_ms * 1_000_000;
     let (mut processed, mut found) = (0u64, 0u64);
-    while waiter.wait(None)? != Wake::Shutdown {
+    while pace.next(&waiter, None)? != Step::Stop {
         expectations.drain(|e| {
             wanted.insert(e.landmark_index, *e);
         })?;
         // Work on the newest frame only: a late worker skips, it does not fall further behind.
-        let Some(frame) = frames.latest()? else { continue };
+        let Some(frame) = frames.latest()? else {
+            pace.done()?;
+            continue;
+        };
         let h = *frame.header();
         match edges.run(&h, frame.pixels()) {
             Ok(d) => {
@@ -72,6 +75,8 @@ fn main() -> anyhow::Result<()> {
                 sightings.send(&s)?;
             }
         }
+        drop(frame);
+        pace.done()?;
     }
     tracing::info!(processed, found, "vision workers stopped");
     Ok(())

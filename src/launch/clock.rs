@@ -1,0 +1,107 @@
+//! The supervisor's side of deterministic mode: it starts the clock chain once every service is
+//! ready, resumes it after a party restarts, and says which party holds it up when it stalls.
+
+use std::time::{Duration, Instant};
+
+use harvey_bus::{Bus, Publisher, Subscriber};
+use harvey_msgs::{Header, Progress, topics};
+
+/// How long the chain may stand still before the supervisor names the party it waits for.
+const STALL_WARNING: Duration = Duration::from_secs(10);
+
+struct Party {
+    name: String,
+    progress: Subscriber<Progress>,
+    /// The supervisor's own port on the party's topic, to start or resume the chain.
+    stand_in: Publisher<Progress>,
+    last: Option<u64>,
+}
+
+/// Watches every party's progress.
+pub struct ClockWatch {
+    parties: Vec<Party>,
+    moved_at: Instant,
+    warned: bool,
+    _bus: Bus,
+}
+
+impl ClockWatch {
+    /// `chain` is the parties in turn order, master first.
+    pub fn new(prefix: &str, chain: &[String]) -> anyhow::Result<Self> {
+        let bus = Bus::join_with_prefix("harvey-supervisor", prefix)?;
+        let parties = chain
+            .iter()
+            .map(|name| {
+                let topic = topics::clock_progress(name);
+                Ok(Party {
+                    name: name.clone(),
+                    progress: bus.subscriber(topic)?,
+                    stand_in: bus.publisher(topic)?,
+                    last: None,
+                })
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        Ok(Self { parties, moved_at: Instant::now(), warned: false, _bus: bus })
+    }
+
+    /// Starts the chain: the tail "has finished" tick 0, so the master begins tick 1.
+    pub fn start(&mut self) -> anyhow::Result<()> {
+        let Some(tail) = self.parties.last_mut() else { return Ok(()) };
+        tail.stand_in.send(&Progress { header: Header::new(0, 0) })?;
+        tail.last = Some(0);
+        self.moved_at = Instant::now();
+        tracing::info!(chain = ?self.parties.iter().map(|p| &p.name).collect::<Vec<_>>(), "deterministic clock started");
+        Ok(())
+    }
+
+    /// Takes in the parties' progress; warns once when the chain has not moved for a while.
+    pub fn poll(&mut self) -> anyhow::Result<()> {
+        for p in &mut self.parties {
+            if let Some(m) = p.progress.latest()? {
+                p.last = Some(m.header.stamp_ns);
+                self.moved_at = Instant::now();
+                self.warned = false;
+            }
+        }
+        if !self.warned && self.moved_at.elapsed() > STALL_WARNING {
+            self.warned = true;
+            let (waiting, tick) = self.holder();
+            tracing::warn!(
+                party = %waiting,
+                tick_ms = tick / 1_000_000,
+                "deterministic clock has not moved for {} s: waiting for `{waiting}`",
+                STALL_WARNING.as_secs()
+            );
+        }
+        Ok(())
+    }
+
+    /// The party whose turn it is, and the last tick its predecessor finished.
+    fn holder(&self) -> (&str, u64) {
+        let newest = self.parties.iter().filter_map(|p| p.last).max().unwrap_or(0);
+        let n = self.parties.len();
+        for i in 0..n {
+            let pred = self.parties[(i + n - 1) % n].last.unwrap_or(0);
+            if self.parties[i].last.unwrap_or(0) < pred || (i == 0 && pred == newest) {
+                return (&self.parties[i].name, pred);
+            }
+        }
+        (&self.parties[0].name, newest)
+    }
+
+    /// After `party` restarted: if its predecessor finished a tick it had not, hand the restarted
+    /// party that turn again (its earlier self took the notice with it).
+    pub fn resume(&mut self, party: &str) -> anyhow::Result<()> {
+        self.poll()?;
+        let n = self.parties.len();
+        let Some(i) = self.parties.iter().position(|p| p.name == party) else { return Ok(()) };
+        let pred = &self.parties[(i + n - 1) % n];
+        if let Some(t) = pred.last
+            && self.parties[i].last.is_none_or(|own| own < t)
+        {
+            pred.stand_in.send(&Progress { header: Header::new(0, t) })?;
+            tracing::warn!(party, tick_ms = t / 1_000_000, "deterministic clock resumed after a restart");
+        }
+        Ok(())
+    }
+}
