@@ -2,6 +2,7 @@
 //! supervisor, and inspect recordings.
 
 mod launch;
+mod replay;
 mod summary;
 
 use std::path::{Path, PathBuf};
@@ -26,6 +27,16 @@ enum Cmd {
     /// Run a launch file under the supervisor.
     Launch {
         file: PathBuf,
+        #[command(flatten)]
+        opts: LaunchArgs,
+    },
+    /// Run a recording's services again on its recorded inputs (deterministically, as fast as
+    /// they go) and record them again; `--check` compares the new recording with the old.
+    Replay {
+        recording: PathBuf,
+        /// Report the first message that differs, and exit 1 if any does.
+        #[arg(long)]
+        check: bool,
         #[command(flatten)]
         opts: LaunchArgs,
     },
@@ -118,6 +129,22 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             let (outcome, _) = launch_file(&file, &opts)?;
             println!("launch: {outcome:?}");
             Ok(outcome.exit_code())
+        }
+        Cmd::Replay { recording, check, opts } => {
+            let run_dir = opts
+                .run_dir
+                .clone()
+                .unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
+            let file = replay::prepare(&recording, &run_dir)?;
+            let (outcome, _) = launch_file(&file, &LaunchArgs { run_dir: Some(run_dir.clone()), ..opts })?;
+            println!("replay: {outcome:?}");
+            let again = run_dir.join("run.mcap");
+            println!("recording: {}", again.display());
+            if outcome.exit_code() != 0 || !check {
+                return Ok(outcome.exit_code());
+            }
+            let c = harvey_recorder::compare::compare(&recording, &again, &|_| true)?;
+            Ok(report_comparison(&c, &recording, &again))
         }
         Cmd::Info { recording } => {
             print!("{}", summary::RunStats::read(&recording)?.info_table());

@@ -277,7 +277,8 @@ mod tests {
         let text = "[launch]\nname = \"t\"\nclock = \"lockstep\"\nclock_master = \"c\"\n\n[[service]]\nname = \"a\"\n\n[[service]]\nname = \"b\"\nclock_party = false\n\n[[service]]\nname = \"c\"\n\n[[service]]\nname = \"d\"\n";
         let l = parse(text).expect("parses");
         assert_eq!(l.clock_chain(), ["c", "d", "a"]);
-        let e = parse(&text.replace("clock_master = \"c\"", "clock_master = \"b\"")).expect_err("not a party");
+        let e =
+            parse(&text.replace("clock_master = \"c\"", "clock_master = \"b\"")).expect_err("not a party");
         assert!(e.to_string().starts_with("m.toml:4: key `launch.clock_master`"), "{e}");
         let e = parse(&text.replace("clock_master = \"c\"\n", "")).expect_err("no master");
         assert!(e.to_string().contains("lockstep needs `launch.clock_master`"), "{e}");

@@ -53,10 +53,14 @@ pub enum Line {
     Report(Report),
     /// DRV → host, deterministic mode only (a Harvey extension; see `docs/drv-protocol.md`):
     /// every report of the tick ending at `time_ms` has been sent.
-    Tick { time_ms: u64 },
+    Tick {
+        time_ms: u64,
+    },
     /// Host → DRV, deterministic mode only: every command of the tick ending at `time_ms` has
     /// been sent; the DRV may simulate the next tick.
-    Sync { time_ms: u64 },
+    Sync {
+        time_ms: u64,
+    },
 }
 
 /// What is wrong with a received frame.

@@ -29,13 +29,19 @@ impl Camera {
         pose: [f64; 3],
         world_m: [f64; 3],
     ) -> Option<[f64; 2]> {
-        let (dx, dy) = (world_m[0] - pose[0], world_m[1] - pose[1]);
-        let (c, s) = (pose[2].cos(), pose[2].sin());
-        let robot = [dx * c + dy * s, -dx * s + dy * c, world_m[2], 1.0];
-        let m = self.calibration(width_px, height_px);
-        let [a, b, w] = [0, 1, 2].map(|j| (0..4).map(|i| robot[i] * m[i][j]).sum::<f64>());
-        (w > 1e-9).then(|| [a / w, b / w])
+        let (s, c) = pose[2].sin_cos();
+        project_with(&self.calibration(width_px, height_px), [pose[0], pose[1], c, s], world_m)
     }
+}
+
+/// [`Camera::project`] with the calibration `m` and the pose's heading as `[x, y, cos, sin]`
+/// worked out beforehand: for loops that project many points from many poses.
+pub fn project_with(m: &[[f64; 3]; 4], pose: [f64; 4], world_m: [f64; 3]) -> Option<[f64; 2]> {
+    let [x, y, c, s] = pose;
+    let (dx, dy) = (world_m[0] - x, world_m[1] - y);
+    let robot = [dx * c + dy * s, -dx * s + dy * c, world_m[2], 1.0];
+    let [a, b, w] = [0, 1, 2].map(|j| (0..4).map(|i| robot[i] * m[i][j]).sum::<f64>());
+    (w > 1e-9).then(|| [a / w, b / w])
 }
 
 #[cfg(test)]

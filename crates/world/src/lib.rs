@@ -8,6 +8,7 @@ mod model;
 mod raycast;
 pub mod topology;
 
+pub use camera::project_with;
 pub use load::{WorldError, load_str};
 pub use model::*;
 pub use raycast::Hit;

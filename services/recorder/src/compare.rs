@@ -57,7 +57,12 @@ pub fn first_difference(a: &[Record], b: &[Record]) -> Option<Difference> {
         let detail = if x.topic != y.topic || x.log_time != y.log_time {
             format!("expected {}, found {}", at(x), at(y))
         } else if x.data != y.data {
-            let byte = x.data.iter().zip(&y.data).position(|(p, q)| p != q).unwrap_or(x.data.len().min(y.data.len()));
+            let byte = x
+                .data
+                .iter()
+                .zip(&y.data)
+                .position(|(p, q)| p != q)
+                .unwrap_or(x.data.len().min(y.data.len()));
             format!(
                 "{}: payloads differ from byte {byte} ({} vs {} bytes)",
                 at(x),
@@ -99,7 +104,10 @@ mod tests {
         b = a.clone();
         b[0].log_time = 100_000_000;
         let d = first_difference(&a, &b).expect("differs");
-        assert_eq!((d.index, d.detail.as_str()), (0, "expected `odometry` at 0.050 s, found `odometry` at 0.100 s"));
+        assert_eq!(
+            (d.index, d.detail.as_str()),
+            (0, "expected `odometry` at 0.050 s, found `odometry` at 0.100 s")
+        );
         let d = first_difference(&a, &a[..1]).expect("shorter");
         assert_eq!(d.detail, "the first recording has 1 more messages, from `ums/map` at 0.050 s");
     }

@@ -23,6 +23,9 @@ const QOS_YAML: &str = "- history: 1\n  depth: 16\n  reliability: 1\n  durabilit
 
 /// Media type of the world file attached to a recording.
 pub const WORLD_MEDIA_TYPE: &str = "application/toml; harvey-world";
+/// Media type of the launch file (services and mission) attached to a recording: what
+/// `harvey replay` runs again.
+pub const LAUNCH_MEDIA_TYPE: &str = "application/toml; harvey-launch";
 
 /// MCAP's chunk size: large enough to compress well, small enough to bound a crash's loss.
 const CHUNK_BYTES: u64 = 4 << 20;
@@ -100,6 +103,20 @@ impl Recorder {
     }
 
     fn write(&mut self, ch: Channel, seq: u64, stamp_ns: u64) -> Result<(), RecordError> {
+        let data = std::mem::take(&mut self.scratch);
+        let result = self.record_encoded(ch, seq, stamp_ns, &data);
+        self.scratch = data;
+        result
+    }
+
+    /// Records a message already in CDR (what [`Recorder::record`] would have encoded).
+    pub fn record_encoded(
+        &mut self,
+        ch: Channel,
+        seq: u64,
+        stamp_ns: u64,
+        data: &[u8],
+    ) -> Result<(), RecordError> {
         let (id, stats) = &mut self.channels[ch.0];
         if let Some(last) = stats.last_seq {
             stats.seq_gaps += seq.saturating_sub(last + 1);
@@ -112,7 +129,7 @@ impl Recorder {
             log_time: stamp_ns,
             publish_time: stamp_ns,
         };
-        let result = self.writer.write_to_known_channel(&header, &self.scratch);
+        let result = self.writer.write_to_known_channel(&header, data);
         result.map_err(|e| self.err(e))
     }
 
@@ -133,11 +150,20 @@ impl Recorder {
 
     /// Stores the world file the run used, so that offline tools (`harvey export`) can draw it.
     pub fn attach_world(&mut self, name: &str, text: &str) -> Result<(), RecordError> {
+        self.attach(name, WORLD_MEDIA_TYPE, text)
+    }
+
+    /// Stores the launch file of the run, so that `harvey replay` can run its services again.
+    pub fn attach_launch(&mut self, name: &str, text: &str) -> Result<(), RecordError> {
+        self.attach(name, LAUNCH_MEDIA_TYPE, text)
+    }
+
+    fn attach(&mut self, name: &str, media_type: &str, text: &str) -> Result<(), RecordError> {
         let a = mcap::Attachment {
             log_time: 0,
             create_time: 0,
             name: name.to_owned(),
-            media_type: WORLD_MEDIA_TYPE.to_owned(),
+            media_type: media_type.to_owned(),
             data: std::borrow::Cow::Borrowed(text.as_bytes()),
         };
         self.writer.attach(&a).map_err(|e| self.err(e))

@@ -7,12 +7,17 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, FrameSubscriber, Pace, Step, Subscriber, Waitable, Waiter};
+use harvey_bus::{Bus, Pace, Step, Waitable, Waiter};
 use harvey_cdr::Ros2Msg;
 use harvey_msgs::{Message, Topic, topics};
-use harvey_recorder::draw::Draw;
+use harvey_recorder::Recorder;
 use harvey_recorder::rrd::RrdWriter;
-use harvey_recorder::{Channel, Recorder};
+
+mod taps;
+mod writer;
+
+use taps::{Batch, FrameTap, Intake, MsgTap, Tap};
+use writer::{Files, Writer};
 
 #[derive(Parser)]
 #[command(about = "Record every topic to an MCAP file")]
@@ -29,86 +34,12 @@ struct Args {
     /// The world file of the run: attached to the MCAP file and drawn in the Rerun file.
     #[arg(long)]
     world: Option<PathBuf>,
+    /// The launch file of the run: attached to the MCAP file for `harvey replay`.
+    #[arg(long)]
+    launch: Option<PathBuf>,
 }
 
-/// Where recorded messages go.
-struct Sinks {
-    mcap: Recorder,
-    rrd: Option<RrdWriter>,
-    /// Deterministic mode: messages stamped after this belong to a tick the chain never
-    /// finished (the launch stopped inside it) and are left out.
-    until_ns: u64,
-    left_out: u64,
-}
-
-impl Sinks {
-    fn admits(&mut self, stamp_ns: u64) -> bool {
-        let keep = stamp_ns <= self.until_ns;
-        self.left_out += u64::from(!keep);
-        keep
-    }
-}
-
-/// A subscribed topic feeding a channel.
-trait Tap {
-    fn waitable(&self) -> &dyn Waitable;
-    fn drain(&self, out: &mut Sinks) -> anyhow::Result<usize>;
-}
-
-struct MsgTap<T: Message> {
-    sub: Subscriber<T>,
-    channel: Channel,
-}
-
-impl<T: Message + Ros2Msg + Draw> Tap for MsgTap<T> {
-    fn waitable(&self) -> &dyn Waitable {
-        &self.sub
-    }
-    fn drain(&self, out: &mut Sinks) -> anyhow::Result<usize> {
-        let mut written = Ok(());
-        let n = self.sub.drain(|m| {
-            if written.is_ok() && out.admits(m.header().stamp_ns) {
-                written = out.mcap.record(self.channel, m);
-            }
-            if let (Ok(()), Some(rrd), true) = (&written, out.rrd.as_mut(), m.header().stamp_ns <= out.until_ns) {
-                written = m.draw(rrd);
-            }
-        })?;
-        written?;
-        Ok(n)
-    }
-}
-
-struct FrameTap {
-    sub: FrameSubscriber,
-    channel: Channel,
-}
-
-impl Tap for FrameTap {
-    fn waitable(&self) -> &dyn Waitable {
-        &self.sub
-    }
-    fn drain(&self, out: &mut Sinks) -> anyhow::Result<usize> {
-        let mut n = 0;
-        while let Some(frame) = self.sub.take()? {
-            if !out.admits(frame.header().stamp_ns) {
-                continue;
-            }
-            out.mcap.record_frame(self.channel, frame.header(), frame.pixels())?;
-            if let Some(rrd) = out.rrd.as_mut() {
-                rrd.frame(frame.header(), frame.pixels())?;
-            }
-            n += 1;
-        }
-        Ok(n)
-    }
-}
-
-fn tap<T: Message + Ros2Msg + Draw>(
-    bus: &Bus,
-    rec: &mut Recorder,
-    topic: Topic<T>,
-) -> anyhow::Result<Box<dyn Tap>> {
+fn tap<T: Message + Ros2Msg>(bus: &Bus, rec: &mut Recorder, topic: Topic<T>) -> anyhow::Result<Box<dyn Tap>> {
     let channel = rec.channel::<T>(topic.name)?;
     Ok(Box::new(MsgTap { sub: bus.subscriber(topic)?, channel }))
 }
@@ -128,6 +59,11 @@ fn main() -> anyhow::Result<()> {
         }
         None => None,
     };
+    if let Some(path) = &args.launch {
+        let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+        let name = path.file_name().map_or("launch.toml".into(), |n| n.to_string_lossy().into_owned());
+        rec.attach_launch(&name, &text)?;
+    }
     let rrd = args.rrd.as_ref().map(|p| RrdWriter::create(p, world.as_ref())).transpose()?;
     let bus = Bus::join("recorder")?;
     let frame_channel = rec.image_channel(topics::CAMERA_FRAME.name)?;
@@ -148,55 +84,51 @@ fn main() -> anyhow::Result<()> {
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();
     let missing: Vec<&&str> = topics::ALL.iter().filter(|t| !recorded.contains(t)).collect();
     anyhow::ensure!(missing.is_empty(), "the recorder has no tap for {missing:?}");
-    let mut sinks = Sinks { mcap: rec, rrd, until_ns: u64::MAX, left_out: 0 };
-
     let pace = Pace::from_env(&bus)?;
     let lockstep = pace.lockstep().is_some();
     let waiter = Waiter::new()?;
     let waitables: Vec<&dyn Waitable> = taps.iter().map(|t| t.waitable()).collect();
     let _attached = pace.attach(&waiter, &waitables)?;
+    let flush_every = Duration::from_millis(args.flush_ms.max(1));
+    let writer = Writer::start(Files { mcap: rec, rrd }, flush_every)?;
     harvey_runtime::notify_ready()?;
     tracing::info!(output = %args.output.display(), topics = taps.len(), lockstep, "recording");
 
-    let flush_every = Duration::from_millis(args.flush_ms.max(1));
-    let mut last_flush = Instant::now();
+    let mut intake = Intake { batch: Batch::default(), spare: Vec::new(), until_ns: u64::MAX, left_out: 0 };
     let mut last_turn: Option<Instant> = None;
     loop {
         let step = pace.next(&waiter, Some(flush_every))?;
         if let Step::Go(Some(tick)) = step {
-            sinks.until_ns = tick;
+            intake.until_ns = tick;
             // Wall time the whole chain took for this tick: the loop latency plot.
             let now = Instant::now();
-            if let (Some(at), Some(rrd)) = (last_turn, sinks.rrd.as_mut()) {
-                rrd.loop_latency(tick, now.duration_since(at).as_secs_f64() * 1e3)?;
-            }
+            intake.batch.loop_latency =
+                last_turn.map(|at| (tick, now.duration_since(at).as_secs_f64() * 1e3));
             last_turn = Some(now);
+        }
+        while let Some(b) = writer.returned() {
+            intake.recycle(b);
         }
         // In deterministic mode an idle wake-up must not take a tick still under way.
         if !(lockstep && step == Step::Idle) {
             for t in &taps {
-                t.drain(&mut sinks)?;
+                t.take(&mut intake)?;
             }
         }
+        // The tick's messages are out of shared memory: the chain may go on while they are
+        // written.
         pace.done()?;
-        if last_flush.elapsed() >= flush_every {
-            sinks.mcap.flush()?;
-            if let Some(rrd) = &sinks.rrd {
-                rrd.flush()?;
-            }
-            last_flush = Instant::now();
+        if !intake.batch.items.is_empty() || intake.batch.loop_latency.is_some() {
+            writer.send(std::mem::take(&mut intake.batch))?;
         }
         if step == Step::Stop {
             break;
         }
     }
     drop(_attached);
-    let stats = sinks.mcap.finish()?;
-    if let Some(rrd) = sinks.rrd {
-        rrd.finish()?;
-    }
+    let stats = writer.finish()?;
     let total: u64 = stats.iter().map(|s| s.messages).sum();
     let gaps: u64 = stats.iter().map(|s| s.seq_gaps).sum();
-    tracing::info!(messages = total, seq_gaps = gaps, left_out = sinks.left_out, output = %args.output.display(), "recording finished");
+    tracing::info!(messages = total, seq_gaps = gaps, left_out = intake.left_out, output = %args.output.display(), "recording finished");
     Ok(())
 }

@@ -3,7 +3,7 @@
 //! calibration — widened for the perceptual strategy that will look in it. For comparison, the
 //! window a disk model of the same uncertainty gives (002 Fig. 68–69).
 
-use harvey_world::{Camera, Landmark, LandmarkClass};
+use harvey_world::{Camera, Landmark, LandmarkClass, project_with};
 
 use crate::geometry::Pt;
 use crate::map::{Map, wrap};
@@ -53,18 +53,34 @@ pub fn feature_points(l: &Landmark, near: Pt, reach_m: f64) -> Vec<[f64; 3]> {
     }
 }
 
-/// The bounding box of `points` seen from every `(position, heading)` in `poses`, clipped to
-/// the image and widened by `margin_px`; `None` if nothing projects into view.
-fn bounds(view: View<'_>, poses: &[(Pt, f64)], points: &[[f64; 3]], margin_px: f64) -> Option<Window> {
-    let (w, h) = (f64::from(view.width_px), f64::from(view.height_px));
+/// Headings to try from `p` for `target`: the wedge's limits, and the heading facing the
+/// target when the wedge holds it (where its depth, and so its image row, peaks). Between them a
+/// point's image position moves monotonically, so these bound it over the whole wedge.
+fn headings(map: &Map, p: Pt, target: [f64; 3]) -> ([f64; 3], usize) {
+    let [lo, hi] = map.wedge();
+    let facing = map.heading_rad + wrap((target[1] - p[1]).atan2(target[0] - p[0]) - map.heading_rad);
+    ([lo, hi, facing], if (lo..=hi).contains(&facing) { 3 } else { 2 })
+}
+
+/// The Expecter's window for landmark `l` under `map`: the bounding box of its feature points
+/// seen from every polygon vertex at each point's bounding headings, clipped to the image and
+/// widened by `margin_px`; `None` if nothing projects into view.
+pub fn window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option<Window> {
+    let points = feature_points(l, map.centre, l.activation_range_m);
+    let m = view.camera.calibration(view.width_px, view.height_px);
     let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
-    for (p, th) in poses {
-        for x in points {
-            if let Some([u, v]) = view.camera.project(view.width_px, view.height_px, [p[0], p[1], *th], *x) {
-                b = [b[0].min(u), b[1].min(v), b[2].max(u), b[3].max(v)];
+    for p in &map.polygon {
+        for x in &points {
+            let (hs, n) = headings(map, *p, *x);
+            for th in &hs[..n] {
+                let (s, c) = th.sin_cos();
+                if let Some([u, v]) = project_with(&m, [p[0], p[1], c, s], *x) {
+                    b = [b[0].min(u), b[1].min(v), b[2].max(u), b[3].max(v)];
+                }
             }
         }
     }
+    let (w, h) = (f64::from(view.width_px), f64::from(view.height_px));
     let win = Window {
         u0: (b[0] - margin_px).max(0.0),
         v0: (b[1] - margin_px).max(0.0),
@@ -72,29 +88,6 @@ fn bounds(view: View<'_>, poses: &[(Pt, f64)], points: &[[f64; 3]], margin_px: f
         v1: (b[3] + margin_px).min(h),
     };
     (b[0].is_finite() && win.u0 < win.u1 && win.v0 < win.v1).then_some(win)
-}
-
-/// Headings to try from `p`: the wedge's limits, and the heading facing the landmark when the
-/// wedge holds it (where its depth, and so its image row, peaks).
-fn headings(map: &Map, p: Pt, target: [f64; 3]) -> Vec<f64> {
-    let [lo, hi] = map.wedge();
-    let facing = map.heading_rad + wrap((target[1] - p[1]).atan2(target[0] - p[0]) - map.heading_rad);
-    let mut hs = vec![lo, hi];
-    if (lo..=hi).contains(&facing) {
-        hs.push(facing);
-    }
-    hs
-}
-
-/// The Expecter's window for landmark `l` under `map`.
-pub fn window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option<Window> {
-    let points = feature_points(l, map.centre, l.activation_range_m);
-    let poses: Vec<(Pt, f64)> = map
-        .polygon
-        .iter()
-        .flat_map(|p| points.iter().flat_map(|x| headings(map, *p, *x)).map(move |th| (*p, th)))
-        .collect();
-    bounds(view, &poses, &points, margin_px)
 }
 
 /// The window a disk of the same uncertainty (centred on the map's centre, reaching its

@@ -1,0 +1,113 @@
+//! The recorder's taps: one subscription per topic, taking its queued messages out of shared
+//! memory as CDR into a [`Batch`] for the writer thread.
+
+use harvey_bus::{FrameSubscriber, Subscriber, Waitable};
+use harvey_cdr::{Ros2Msg, encode, encode_image};
+use harvey_msgs::Message;
+use harvey_recorder::Channel;
+
+/// One message on its way to the files.
+pub struct Item {
+    pub channel: Channel,
+    pub topic: &'static str,
+    pub seq: u64,
+    pub stamp_ns: u64,
+    pub data: Vec<u8>,
+}
+
+/// What one wake-up took: the messages in the order taken, and (deterministic mode) the wall
+/// time the chain spent on the tick.
+#[derive(Default)]
+pub struct Batch {
+    pub items: Vec<Item>,
+    pub loop_latency: Option<(u64, f64)>,
+}
+
+/// Where taps put messages: the batch, buffers to reuse, and the deterministic-mode limit.
+pub struct Intake {
+    pub batch: Batch,
+    /// Buffers of earlier batches, reused so that steady recording does not allocate.
+    pub spare: Vec<Vec<u8>>,
+    /// Messages stamped after this belong to a tick the chain never finished (the launch
+    /// stopped inside it) and are left out.
+    pub until_ns: u64,
+    pub left_out: u64,
+}
+
+impl Intake {
+    fn admits(&mut self, stamp_ns: u64) -> bool {
+        let keep = stamp_ns <= self.until_ns;
+        self.left_out += u64::from(!keep);
+        keep
+    }
+
+    fn push(
+        &mut self,
+        channel: Channel,
+        topic: &'static str,
+        seq: u64,
+        stamp_ns: u64,
+        fill: impl FnOnce(Vec<u8>) -> Vec<u8>,
+    ) {
+        let data = fill(self.spare.pop().unwrap_or_default());
+        self.batch.items.push(Item { channel, topic, seq, stamp_ns, data });
+    }
+
+    /// Takes back a batch the writer is done with.
+    pub fn recycle(&mut self, mut b: Batch) {
+        self.spare.extend(b.items.drain(..).map(|i| i.data));
+        if self.batch.items.is_empty() && self.batch.items.capacity() < b.items.capacity() {
+            std::mem::swap(&mut self.batch.items, &mut b.items);
+        }
+    }
+}
+
+/// A subscribed topic feeding a channel.
+pub trait Tap {
+    fn waitable(&self) -> &dyn Waitable;
+    /// Takes every queued message; returns how many.
+    fn take(&self, into: &mut Intake) -> anyhow::Result<usize>;
+}
+
+pub struct MsgTap<T: Message> {
+    pub sub: Subscriber<T>,
+    pub channel: Channel,
+}
+
+impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
+    fn waitable(&self) -> &dyn Waitable {
+        &self.sub
+    }
+    fn take(&self, into: &mut Intake) -> anyhow::Result<usize> {
+        Ok(self.sub.drain(|m| {
+            let h = *m.header();
+            if into.admits(h.stamp_ns) {
+                into.push(self.channel, self.sub.topic(), h.seq, h.stamp_ns, |buf| encode(m, buf));
+            }
+        })?)
+    }
+}
+
+pub struct FrameTap {
+    pub sub: FrameSubscriber,
+    pub channel: Channel,
+}
+
+impl Tap for FrameTap {
+    fn waitable(&self) -> &dyn Waitable {
+        &self.sub
+    }
+    fn take(&self, into: &mut Intake) -> anyhow::Result<usize> {
+        let mut n = 0;
+        while let Some(frame) = self.sub.take()? {
+            let h = *frame.header();
+            if into.admits(h.stamp_ns) {
+                into.push(self.channel, self.sub.topic(), h.seq, h.stamp_ns, |buf| {
+                    encode_image(&h, frame.pixels(), buf)
+                });
+            }
+            n += 1;
+        }
+        Ok(n)
+    }
+}

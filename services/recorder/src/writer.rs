@@ -1,0 +1,103 @@
+//! The recorder's writer thread: compresses and writes batches to the MCAP file and draws them
+//! into the Rerun file, off the bus thread, so that a party of the clock chain is done with a
+//! tick as soon as it has taken the tick's messages out of shared memory.
+
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, SyncSender, TryRecvError, sync_channel};
+use std::thread::JoinHandle;
+use std::time::{Duration, Instant};
+
+use harvey_recorder::export::draw_recorded;
+use harvey_recorder::rrd::RrdWriter;
+use harvey_recorder::{ChannelStats, Recorder};
+
+use crate::taps::Batch;
+
+/// Batches the bus thread may queue before it waits for the writer (about a second at 20 Hz).
+const QUEUE: usize = 32;
+
+/// The files, owned by the writer thread.
+pub struct Files {
+    pub mcap: Recorder,
+    pub rrd: Option<RrdWriter>,
+}
+
+/// The bus thread's handle on the writer thread.
+pub struct Writer {
+    to_writer: Option<SyncSender<Batch>>,
+    returned: Receiver<Batch>,
+    thread: JoinHandle<anyhow::Result<Vec<ChannelStats>>>,
+}
+
+impl Writer {
+    /// Starts the thread; it flushes both files at least every `flush_every`.
+    pub fn start(files: Files, flush_every: Duration) -> anyhow::Result<Self> {
+        let (to_writer, batches) = sync_channel(QUEUE);
+        let (give_back, returned) = std::sync::mpsc::channel();
+        let thread = std::thread::Builder::new()
+            .name("mcap-writer".into())
+            .spawn(move || write_loop(files, &batches, &give_back, flush_every))?;
+        Ok(Self { to_writer: Some(to_writer), returned, thread })
+    }
+
+    /// Queues a batch; waits if the writer is a whole queue behind.
+    pub fn send(&self, batch: Batch) -> anyhow::Result<()> {
+        let tx = self.to_writer.as_ref().ok_or_else(|| anyhow::anyhow!("writer already finished"))?;
+        // A send fails only when the thread has ended, on an error that `finish` reports.
+        let _ = tx.send(batch);
+        Ok(())
+    }
+
+    /// A batch the writer is done with, if any, for reuse.
+    pub fn returned(&self) -> Option<Batch> {
+        match self.returned.try_recv() {
+            Ok(b) => Some(b),
+            Err(TryRecvError::Empty | TryRecvError::Disconnected) => None,
+        }
+    }
+
+    /// Writes what is queued, finishes both files and returns the per-channel counts.
+    pub fn finish(mut self) -> anyhow::Result<Vec<ChannelStats>> {
+        drop(self.to_writer.take());
+        self.thread.join().map_err(|_| anyhow::anyhow!("the writer thread panicked"))?
+    }
+}
+
+fn write_loop(
+    mut files: Files,
+    batches: &Receiver<Batch>,
+    give_back: &Sender<Batch>,
+    flush_every: Duration,
+) -> anyhow::Result<Vec<ChannelStats>> {
+    let mut last_flush = Instant::now();
+    loop {
+        match batches.recv_timeout(flush_every) {
+            Ok(batch) => {
+                for i in &batch.items {
+                    files.mcap.record_encoded(i.channel, i.seq, i.stamp_ns, &i.data)?;
+                    if let Some(rrd) = files.rrd.as_mut() {
+                        draw_recorded(rrd, i.topic, &i.data)
+                            .map_err(|e| anyhow::anyhow!("drawing {}: {e}", i.topic))?;
+                    }
+                }
+                if let (Some((stamp, ms)), Some(rrd)) = (batch.loop_latency, files.rrd.as_mut()) {
+                    rrd.loop_latency(stamp, ms)?;
+                }
+                let _ = give_back.send(batch);
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => break,
+        }
+        if last_flush.elapsed() >= flush_every {
+            files.mcap.flush()?;
+            if let Some(rrd) = &files.rrd {
+                rrd.flush()?;
+            }
+            last_flush = Instant::now();
+        }
+    }
+    let stats = files.mcap.finish()?;
+    if let Some(rrd) = files.rrd {
+        rrd.finish()?;
+    }
+    Ok(stats)
+}

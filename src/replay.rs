@@ -1,0 +1,94 @@
+//! `harvey replay`: runs a recording's services again on its recorded inputs and records them
+//! again. The recording carries its launch and world files; the replay launch is that launch
+//! with the input producers (simulated DRV, bridge, camera) replaced by `harvey-replayer` as
+//! clock master.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use harvey_recorder::{LAUNCH_MEDIA_TYPE, WORLD_MEDIA_TYPE};
+use harvey_replayer::INPUT_SERVICES;
+
+/// Name of the replay launch file written into the run folder.
+pub const LAUNCH_FILE: &str = "replay.toml";
+
+/// Writes the replay's launch and world files into `run_dir`; returns the launch file's path.
+pub fn prepare(recording: &Path, run_dir: &Path) -> anyhow::Result<PathBuf> {
+    let name = recording.display().to_string();
+    let bytes = std::fs::read(recording).with_context(|| format!("reading {name}"))?;
+    let summary = mcap::Summary::read(&bytes)
+        .with_context(|| format!("{name}: no readable summary (run `harvey recover` on it first)"))?
+        .with_context(|| format!("{name}: no summary (run `harvey recover` on it first)"))?;
+    let attached = |media_type: &str| -> anyhow::Result<String> {
+        let index =
+            summary.attachment_indexes.iter().find(|a| a.media_type == media_type).with_context(|| {
+                format!("{name}: no `{media_type}` attachment: was it recorded by `harvey run`?")
+            })?;
+        let a = mcap::read::attachment(&bytes, index)
+            .with_context(|| format!("{name}: attachment `{}`", index.name))?;
+        String::from_utf8(a.data.to_vec())
+            .with_context(|| format!("{name}: attachment `{}` is not text", a.name))
+    };
+    let (world, launch) = (attached(WORLD_MEDIA_TYPE)?, attached(LAUNCH_MEDIA_TYPE)?);
+    std::fs::create_dir_all(run_dir).with_context(|| format!("creating {}", run_dir.display()))?;
+    let original = std::fs::canonicalize(recording).with_context(|| format!("resolving {name}"))?;
+    let output = std::fs::canonicalize(run_dir)?.join("run.mcap");
+    anyhow::ensure!(output != original, "the replay would overwrite {name}: choose another --run-dir");
+    std::fs::write(run_dir.join("world.toml"), world)?;
+    let text = replay_launch(&launch, &original).with_context(|| format!("{name}: attached launch file"))?;
+    let path = run_dir.join(LAUNCH_FILE);
+    std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+    Ok(path)
+}
+
+/// The launch file of a replay of `recording`, from the launch file that recorded it.
+pub fn replay_launch(text: &str, recording: &Path) -> anyhow::Result<String> {
+    let mut doc: toml::Table = text.parse()?;
+    let launch = doc.get_mut("launch").and_then(|l| l.as_table_mut()).context("no [launch] table")?;
+    let name = launch.get("name").and_then(|n| n.as_str()).unwrap_or("run").to_owned();
+    launch.insert("name".into(), format!("{name}-replay").into());
+    launch.insert("world".into(), "world.toml".into());
+    launch.insert("end_with".into(), "replayer".into());
+    launch.insert("clock".into(), "lockstep".into());
+    launch.insert("clock_master".into(), "replayer".into());
+    let services = doc.get_mut("service").and_then(|s| s.as_array_mut()).context("no [[service]]")?;
+    let is_input = |s: &toml::Value| {
+        let name = s.get("name").and_then(|n| n.as_str()).unwrap_or_default();
+        let binary = s.get("binary").and_then(|b| b.as_str()).map_or(format!("harvey-{name}"), str::to_owned);
+        INPUT_SERVICES.contains(&binary.as_str())
+    };
+    let at =
+        services.iter().position(is_input).context("no input service (simulated DRV, bridge, camera)")?;
+    services.retain(|s| !is_input(s));
+    let mut replayer = toml::Table::new();
+    replayer.insert("name".into(), "replayer".into());
+    replayer.insert("args".into(), vec!["--recording".to_owned(), recording.display().to_string()].into());
+    replayer.insert("restart".into(), "never".into());
+    services.insert(at, replayer.into());
+    Ok(toml::to_string(&doc)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_input_services_give_way_to_the_replayer() {
+        let text = std::fs::read_to_string("missions/default.toml").expect("default mission");
+        let out = replay_launch(&text, Path::new("/r/run.mcap")).expect("rewrites");
+        let lf =
+            crate::launch::LaunchFile::parse(&out, Path::new("replay.toml")).expect("a valid launch file");
+        let names: Vec<&str> = lf.services.iter().map(|s| s.name()).collect();
+        assert_eq!(
+            names,
+            ["recorder", "replayer", "sonar", "encoders", "vision-workers", "ums", "executive"]
+        );
+        assert_eq!(lf.clock_chain()[0], "replayer");
+        assert_eq!(lf.clock_chain().last().map(String::as_str), Some("recorder"));
+        assert_eq!(lf.services[1].args, ["--recording", "/r/run.mcap"]);
+        assert!(out.contains("[mission]") && out.contains("move_m = 4.0"), "the mission travels along");
+        assert!(
+            replay_launch("[launch]\nname = \"x\"\n[[service]]\nname = \"ums\"\n", Path::new("r")).is_err()
+        );
+    }
+}
