@@ -143,9 +143,9 @@ mod tests {
         }
         let (lines, stats) = decode_all(&stream);
         assert_eq!(lines, good);
-        assert_eq!(stats.frames, 8);
-        assert_eq!(stats.truncated + stats.malformed + stats.bad_checksums, 8);
-        assert!(stats.garbage_bytes >= 7 + 5 * 8);
+        assert_eq!(stats.frames, 10);
+        assert_eq!(stats.truncated + stats.malformed + stats.bad_checksums, 10);
+        assert!(stats.garbage_bytes >= 7 + 5 * 10);
     }
 
     #[test]

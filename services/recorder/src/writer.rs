@@ -2,7 +2,7 @@
 //! into the Rerun file, off the bus thread, so that a party of the clock chain is done with a
 //! tick as soon as it has taken the tick's messages out of shared memory.
 
-use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, SyncSender, TryRecvError, sync_channel};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -49,10 +49,7 @@ impl Writer {
 
     /// A batch the writer is done with, if any, for reuse.
     pub fn returned(&self) -> Option<Batch> {
-        match self.returned.try_recv() {
-            Ok(b) => Some(b),
-            Err(TryRecvError::Empty | TryRecvError::Disconnected) => None,
-        }
+        self.returned.try_recv().ok()
     }
 
     /// Writes what is queued, finishes both files and returns the per-channel counts.

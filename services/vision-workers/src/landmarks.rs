@@ -70,8 +70,8 @@ impl LineLandmarks {
                 })
                 .map(|k| (k, p[k] / rows)),
         );
-        self.seq += 1;
-        let header = Header::new(self.seq, h.stamp_ns);
+        // Numbered only when sent, so that a gap in `seq` means a lost message.
+        let header = Header::new(self.seq + 1, h.stamp_ns);
         let base = LandmarkSighting {
             header,
             frame_seq: h.seq,
@@ -81,6 +81,7 @@ impl LineLandmarks {
         let peaks = &self.peaks;
         let best = peaks.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
         let Some((k, strength)) = best else {
+            self.seq += 1;
             return Some(LandmarkSighting { kind: SightingKind::NotFound as u32, ..base });
         };
         if peaks.iter().any(|&(j, s)| j != k && s * self.dominance > strength) {
@@ -89,6 +90,7 @@ impl LineLandmarks {
         // The edge lies on the boundary between columns u and u + 1.
         let u_edge = (u0 + k + 1) as f64;
         let cx = w as f64 / 2.0;
+        self.seq += 1;
         Some(LandmarkSighting {
             kind: SightingKind::Bearing as u32,
             a: ((cx - u_edge) / self.focal_px).atan(),

@@ -1,0 +1,151 @@
+//! Deterministic mode and replay, across real processes: the same mission and seed record the
+//! same messages (topic, log time, bytes) even when two runs share the machine; another seed does
+//! not; the reference recording replays exactly through the live services; and a clock party
+//! killed mid-run is restarted and the chain resumed, so the mission still ends.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+use std::process::Output;
+
+fn text(out: &Output) -> String {
+    format!("{}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
+}
+
+fn run(mission: &Path, tag: &str) -> PathBuf {
+    let (prefix, dir) = (common::unique_prefix(tag), common::scratch(tag));
+    let out = common::harvey(&[
+        "run",
+        mission.to_str().expect("utf8"),
+        "--prefix",
+        &prefix,
+        "--run-dir",
+        dir.to_str().expect("utf8"),
+    ])
+    .output()
+    .expect("runs");
+    assert!(out.status.success(), "{}", text(&out));
+    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
+    dir.join("run.mcap")
+}
+
+/// The number in "identical: N messages ...".
+fn agreed(out: &Output) -> usize {
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line =
+        stdout.lines().find(|l| l.starts_with("identical: ")).unwrap_or_else(|| panic!("{}", text(out)));
+    line.split_whitespace().nth(1).and_then(|n| n.parse().ok()).expect("a count")
+}
+
+fn diff(a: &Path, b: &Path) -> Output {
+    common::harvey(&["diff", a.to_str().expect("utf8"), b.to_str().expect("utf8")])
+        .output()
+        .expect("diff runs")
+}
+
+#[test]
+fn the_same_seed_records_the_same_messages_and_another_seed_does_not() {
+    let default = common::repo().join("missions/default.toml");
+    // Two runs at once: they compete for the CPU, and must not care.
+    let (a, b) = std::thread::scope(|s| {
+        let a = s.spawn(|| run(&default, "det-a"));
+        let b = s.spawn(|| run(&default, "det-b"));
+        (a.join().expect("run a"), b.join().expect("run b"))
+    });
+    let same = diff(&a, &b);
+    assert_eq!(same.status.code(), Some(0), "{}", text(&same));
+    let n = agreed(&same);
+    assert!(n > 6000, "only {n} messages compared");
+
+    let world = common::repo().join("worlds/hallway.toml");
+    let seeded = std::fs::read_to_string(&default)
+        .expect("default mission")
+        .replace("seed = 1", "seed = 2")
+        .replace("../worlds/hallway.toml", world.to_str().expect("utf8"));
+    let file = common::scratch("det-seed").join("seed2.toml");
+    std::fs::write(&file, seeded).expect("written");
+    let c = run(&file, "det-c");
+    let other = diff(&a, &c);
+    let out = String::from_utf8_lossy(&other.stdout);
+    assert_eq!(other.status.code(), Some(1), "{}", text(&other));
+    assert!(out.starts_with("DIFFERENT at message "), "{out}");
+}
+
+#[test]
+fn the_reference_recording_replays_exactly() {
+    let reference = common::repo().join("recordings/reference/default.mcap");
+    let (prefix, dir) = (common::unique_prefix("replay"), common::scratch("replay"));
+    let out = common::harvey(&[
+        "replay",
+        reference.to_str().expect("utf8"),
+        "--check",
+        "--prefix",
+        &prefix,
+        "--run-dir",
+        dir.to_str().expect("utf8"),
+    ])
+    .output()
+    .expect("replay runs");
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "the reference no longer replays: if a service was meant to change its output, run \
+         scripts/update-reference and say so in the commit\n{}",
+        text(&out)
+    );
+    assert_eq!(agreed(&out), 6337, "{}", text(&out));
+    assert!(text(&out).contains("replay finished"), "{}", text(&out));
+    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
+    // The replay refuses to overwrite what it replays.
+    let clash = common::harvey(&[
+        "replay",
+        dir.join("run.mcap").to_str().expect("utf8"),
+        "--prefix",
+        &prefix,
+        "--run-dir",
+        dir.to_str().expect("utf8"),
+    ])
+    .output()
+    .expect("runs");
+    assert_eq!(clash.status.code(), Some(2));
+    assert!(text(&clash).contains("would overwrite"), "{}", text(&clash));
+}
+
+#[test]
+fn a_clock_party_killed_mid_run_is_resumed_and_the_mission_ends() {
+    let (prefix, dir) = (common::unique_prefix("det-kill"), common::scratch("det-kill"));
+    let mut child = common::harvey(&[
+        "run",
+        "missions/default.toml",
+        "--prefix",
+        &prefix,
+        "--run-dir",
+        dir.to_str().expect("utf8"),
+    ])
+    .stdout(std::process::Stdio::piped())
+    .stderr(std::process::Stdio::piped())
+    .spawn()
+    .expect("starts");
+    // Kill the sonar once odometry has flowed for a while (the chain is running).
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let sonar = loop {
+        assert!(std::time::Instant::now() < deadline, "the sonar never came up");
+        let nodes = harvey_bus::live_nodes(&prefix).unwrap_or_default();
+        if let Some(n) = nodes.iter().find(|n| n.alive && n.name == "sonar")
+            && nodes.iter().any(|n| n.alive && n.name == "executive")
+        {
+            break n.pid;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    // SAFETY: kill(2) on a process of this test's own launch.
+    unsafe { libc::kill(sonar, libc::SIGKILL) };
+    let status = common::wait_exit(&mut child, std::time::Duration::from_secs(120));
+    let out = child.wait_with_output().expect("output");
+    let all = text(&out);
+    assert!(status.success(), "{all}");
+    assert!(all.contains("restarted service=sonar"), "{all}");
+    assert!(all.contains("goal reached (3/3 steps)"), "{all}");
+    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
+}
