@@ -41,15 +41,23 @@ impl Intake {
         keep
     }
 
+    /// A spare buffer that holds `bytes` without growing (a fresh frame-sized buffer would cost
+    /// a page fault per 4 KiB), else any spare one.
+    fn buffer(&mut self, bytes: usize) -> Vec<u8> {
+        match self.spare.iter().position(|b| b.capacity() >= bytes) {
+            Some(i) => self.spare.swap_remove(i),
+            None => self.spare.pop().unwrap_or_default(),
+        }
+    }
+
     fn push(
         &mut self,
         channel: Channel,
         topic: &'static str,
-        seq: u64,
-        stamp_ns: u64,
+        (seq, stamp_ns, bytes): (u64, u64, usize),
         fill: impl FnOnce(Vec<u8>) -> Vec<u8>,
     ) {
-        let data = fill(self.spare.pop().unwrap_or_default());
+        let data = fill(self.buffer(bytes));
         self.batch.items.push(Item { channel, topic, seq, stamp_ns, data });
     }
 
@@ -82,7 +90,8 @@ impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
         Ok(self.sub.drain(|m| {
             let h = *m.header();
             if into.admits(h.stamp_ns) {
-                into.push(self.channel, self.sub.topic(), h.seq, h.stamp_ns, |buf| encode(m, buf));
+                let bytes = 64 + core::mem::size_of::<T>();
+                into.push(self.channel, self.sub.topic(), (h.seq, h.stamp_ns, bytes), |buf| encode(m, buf));
             }
         })?)
     }
@@ -98,11 +107,16 @@ impl Tap for FrameTap {
         &self.sub
     }
     fn take(&self, into: &mut Intake) -> anyhow::Result<usize> {
+        // At most a queue's worth per call: against a publisher going flat out, an unbounded
+        // loop would never end, and would pile frames up in memory.
         let mut n = 0;
-        while let Some(frame) = self.sub.take()? {
+        while n < harvey_msgs::Qos::FRAMES.buffer
+            && let Some(frame) = self.sub.take()?
+        {
             let h = *frame.header();
             if into.admits(h.stamp_ns) {
-                into.push(self.channel, self.sub.topic(), h.seq, h.stamp_ns, |buf| {
+                let bytes = 128 + frame.pixels().len();
+                into.push(self.channel, self.sub.topic(), (h.seq, h.stamp_ns, bytes), |buf| {
                     encode_image(&h, frame.pixels(), buf)
                 });
             }

@@ -12,8 +12,9 @@ use harvey_recorder::{ChannelStats, Recorder};
 
 use crate::taps::Batch;
 
-/// Batches the bus thread may queue before it waits for the writer (about a second at 20 Hz).
-const QUEUE: usize = 32;
+/// Batches the bus thread may queue before it waits for the writer: enough to ride out a slow
+/// write, few enough to bound the memory held (a batch may hold 1080p frames).
+const QUEUE: usize = 8;
 
 /// The files, owned by the writer thread.
 pub struct Files {
