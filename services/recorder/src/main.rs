@@ -1,6 +1,8 @@
 //! harvey-recorder: subscribes to every topic and writes them to `run.mcap` (and, with `--rrd`,
-//! draws them into a Rerun file). It never slows a publisher (its queues overwrite when full; the
-//! gaps are counted), flushes at least every second, and finishes the files on SIGINT/SIGTERM.
+//! draws them into a Rerun file). In real time it never slows a publisher (its queues overwrite
+//! when full; the gaps are counted); in deterministic mode it is the clock chain's tail and
+//! records every tick whole. It flushes at least every second and finishes the files on
+//! SIGINT/SIGTERM.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
