@@ -1,0 +1,141 @@
+//! Per-kernel benchmark: each kernel at 640x480 and 256x256, over the full frame and in a window,
+//! against a straightforward reference implementation measured in the same run, single thread,
+//! on rendered hallway frames. Writes the frames (PGM) and the figures (TSV) to
+//! `target/vision-bench/` for `scripts/bench-opencv`, which times OpenCV on the same images.
+//!
+//! `taskset -c 0 cargo bench -p harvey-vision --bench kernels`
+
+mod reference;
+
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Instant;
+
+use harvey_camera::Renderer;
+use harvey_msgs::Encoding;
+use harvey_vision::nc::{Correlator, Template};
+use harvey_vision::{Gray, GrayBuf, Rect};
+
+/// Median microseconds per call of `f`, over enough calls to fill about 0.3 s.
+fn time(mut f: impl FnMut()) -> f64 {
+    let start = Instant::now();
+    f();
+    let once = start.elapsed().as_secs_f64().max(1e-7);
+    let reps = ((0.3 / once) as usize).clamp(5, 20_000);
+    let mut samples: Vec<f64> = (0..reps)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64() * 1e6
+        })
+        .collect();
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
+
+struct Row {
+    kernel: &'static str,
+    size: String,
+    scope: String,
+    harvey_us: f64,
+    reference_us: f64,
+}
+
+fn frame(world: &harvey_world::World, w: u32, h: u32) -> GrayBuf {
+    let mut r = Renderer::new(world, w, h, Encoding::Mono8);
+    let mut px = vec![0u8; r.frame_bytes()];
+    // Looking down the hallway from its start: door jambs, tiles, signs.
+    r.render(world, [0.5, -0.3, 0.05], &mut px).expect("renders");
+    GrayBuf { width: w as usize, height: h as usize, data: px }
+}
+
+fn write_pgm(path: &Path, img: &GrayBuf) {
+    let mut bytes = format!("P5\n{} {}\n255\n", img.width, img.height).into_bytes();
+    bytes.extend_from_slice(&img.data);
+    std::fs::write(path, bytes).expect("writes the frame");
+}
+
+/// A window of `side` pixels centred in the frame.
+#[allow(dead_code)]
+fn centred(img: &Gray<'_>, side: usize) -> Rect {
+    let (x0, y0) = ((img.width - side) / 2, (img.height - side) / 2);
+    Rect::new(x0, y0, x0 + side, y0 + side)
+}
+
+/// The most textured `side`-pixel square on an 8-pixel grid: a place a template is unique.
+fn textured(img: &Gray<'_>, side: usize) -> Rect {
+    let variance = |x: usize, y: usize| {
+        let px: Vec<f64> = (y..y + side)
+            .flat_map(|r| (x..x + side).map(move |c| (c, r)))
+            .map(|(c, r)| f64::from(img.at(c, r)))
+            .collect();
+        let mean = px.iter().sum::<f64>() / px.len() as f64;
+        px.iter().map(|p| (p - mean).powi(2)).sum::<f64>()
+    };
+    let margin = 24;
+    let (x, y) = (margin..img.width - side - margin)
+        .step_by(8)
+        .flat_map(|x| (margin..img.height - side - margin).step_by(8).map(move |y| (x, y)))
+        .max_by(|a, b| variance(a.0, a.1).total_cmp(&variance(b.0, b.1)))
+        .expect("a patch");
+    Rect::new(x, y, x + side, y + side)
+}
+
+fn around(r: Rect, side: usize) -> Rect {
+    let (x0, y0) = (r.x0 + r.width() / 2 - side / 2, r.y0 + r.height() / 2 - side / 2);
+    Rect::new(x0, y0, x0 + side, y0 + side)
+}
+
+fn bench_nc(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
+    let tr = textured(img, 16);
+    let t = GrayBuf::crop(img, tr).expect("template");
+    let tmpl = Template::new(&t).expect("template");
+    let mut c = Correlator::default();
+    for (scope, win) in [("full frame".to_owned(), img.full()), ("48x48 window".to_owned(), around(tr, 48))] {
+        let m = c.best(img, win, &tmpl).expect("correlates");
+        assert_eq!((m.x, m.y), (tr.x0, tr.y0), "the template is found where it was cut");
+        let harvey_us = time(|| {
+            black_box(c.best(img, win, &tmpl).expect("correlates"));
+        });
+        let reference_us = time(|| {
+            black_box(reference::nc_best(img, win, &t));
+        });
+        rows.push(Row {
+            kernel: "normalised correlation 16x16",
+            size: size.to_owned(),
+            scope,
+            harvey_us,
+            reference_us,
+        });
+    }
+}
+
+fn main() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let world = harvey_world::World::load(&root.join("worlds/hallway.toml")).expect("world");
+    let out = root.join("target/vision-bench");
+    std::fs::create_dir_all(&out).expect("output folder");
+    let mut rows = Vec::new();
+    for (w, h) in [(640u32, 480u32), (256, 256)] {
+        let img = frame(&world, w, h);
+        write_pgm(&out.join(format!("frame_{w}x{h}.pgm")), &img);
+        let size = format!("{w}x{h}");
+        bench_nc(&img.view(), &size, &mut rows);
+    }
+    println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
+    println!("|---|---|---|---:|---:|---:|");
+    let mut tsv = String::from("kernel\tsize\tscope\tharvey_us\treference_us\n");
+    for r in &rows {
+        println!(
+            "| {} | {} | {} | {:.1} | {:.1} | {:.1}x |",
+            r.kernel,
+            r.size,
+            r.scope,
+            r.harvey_us,
+            r.reference_us,
+            r.reference_us / r.harvey_us
+        );
+        tsv += &format!("{}\t{}\t{}\t{:.3}\t{:.3}\n", r.kernel, r.size, r.scope, r.harvey_us, r.reference_us);
+    }
+    std::fs::write(out.join("harvey.tsv"), tsv).expect("writes the figures");
+}

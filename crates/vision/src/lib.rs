@@ -1,0 +1,9 @@
+//! The papers' perceptual algorithms as pure kernels on grey images read in place: each a function
+//! or a state machine with reusable buffers, no IO, no clock. The vision-workers service runs them
+//! on camera frames in shared memory, inside the windows it is asked to look in.
+
+pub mod image;
+pub mod nc;
+mod simd;
+
+pub use image::{Gray, GrayBuf, Rect, VisionError};

@@ -1,0 +1,381 @@
+//! Reflectance-normalised correlation (000 §5.4). Patch and template are each divided by their
+//! own sum, which cancels a constant illumination, and compared by
+//! `NC = 2 ΣRP·RT / (ΣRP² + ΣRT²)`, 1 for a patch proportional to the template.
+//!
+//! With `S_P = ΣP`, `S_T = ΣT` that is `NC = 2 ΣPT S_P S_T / (ΣP² S_T² + ΣT² S_P²)`: only ΣPT
+//! needs the template; `S_P` and `ΣP²` come from integral images. ΣPT is computed as
+//! `Σ P (T - 128) + 128 S_P`, so the template fits signed bytes and, where the CPU has AVX-512
+//! VNNI, sixty-four byte products go into one instruction (`cross_avx512`); elsewhere a portable
+//! loop does the same sums.
+
+use crate::image::{Gray, GrayBuf, Rect, VisionError};
+
+/// Largest template side: keeps `Σ P (T - 128)` inside an `i32`.
+pub const MAX_TEMPLATE: usize = 128;
+
+/// A template prepared for correlation.
+#[derive(Debug, Clone)]
+pub struct Template {
+    pub width: usize,
+    pub height: usize,
+    sum: f64,
+    sum_sq: f64,
+    /// `T - 128` as signed bytes, rows padded to a multiple of 4 with zeros, packed 4 to an i32.
+    packed: Vec<i32>,
+    /// i32 groups per row.
+    groups: usize,
+}
+
+impl Template {
+    pub fn new(t: &GrayBuf) -> Result<Self, VisionError> {
+        let (w, h) = (t.width, t.height);
+        if w == 0 || h == 0 || t.data.len() < w * h {
+            return Err(VisionError::EmptyTemplate);
+        }
+        if w > MAX_TEMPLATE || h > MAX_TEMPLATE {
+            return Err(VisionError::BadParameter(format!(
+                "template {w}x{h} over {MAX_TEMPLATE} pixels a side"
+            )));
+        }
+        let groups = w.div_ceil(4);
+        let mut packed = vec![0i32; groups * h];
+        for y in 0..h {
+            for x in 0..w {
+                let v = (i32::from(t.data[y * w + x]) - 128) as i8 as u8;
+                packed[y * groups + x / 4] |= i32::from(v) << (8 * (x % 4));
+            }
+        }
+        let sum = t.data.iter().map(|&v| f64::from(v)).sum();
+        let sum_sq = t.data.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
+        if sum == 0.0 {
+            return Err(VisionError::BadParameter("an all-black template has no reflectance pattern".into()));
+        }
+        Ok(Self { width: w, height: h, sum, sum_sq, packed, groups })
+    }
+}
+
+/// The best placement of a template.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Match {
+    /// Top-left corner of the best placement, in image pixels.
+    pub x: usize,
+    pub y: usize,
+    /// Centre of the matched template in image coordinates (pixel centres at +0.5), refined to
+    /// a fraction of a pixel by a parabola through the neighbouring scores.
+    pub centre: [f32; 2],
+    pub score: f32,
+}
+
+/// Reusable buffers: correlating a frame allocates nothing once they have grown.
+#[derive(Debug, Default)]
+pub struct Correlator {
+    pad: Vec<u8>,
+    pad_width: usize,
+    /// Per column of the window: the sums of pixels and squares over the template's rows.
+    col_sums: Vec<u32>,
+    col_squares: Vec<u32>,
+    /// Running sums of those along the row (wrapping: only differences are used).
+    run_sums: Vec<u32>,
+    run_squares: Vec<u32>,
+    cross: Vec<i32>,
+    scores: Vec<f32>,
+    nx: usize,
+    ny: usize,
+}
+
+const BLOCK_X: usize = 16;
+const BLOCK_Y: usize = 4;
+
+impl Correlator {
+    /// Scores every placement of `t` whose pixels all lie in `window`: row-major, `nx x ny`
+    /// (see [`Correlator::placements`]), the top-left placement first.
+    pub fn correlate(&mut self, img: &Gray<'_>, window: Rect, t: &Template) -> Result<&[f32], VisionError> {
+        let w = window.inside(img.width, img.height)?;
+        if t.width > w.width() || t.height > w.height() {
+            return Err(VisionError::TemplateTooLarge(t.width, t.height, w));
+        }
+        let (nx, ny) = (w.width() - t.width + 1, w.height() - t.height + 1);
+        (self.nx, self.ny) = (nx, ny);
+        self.copy_padded(img, w, t);
+        self.cross.clear();
+        self.cross.resize(nx.next_multiple_of(BLOCK_X) * ny.next_multiple_of(BLOCK_Y), 0);
+        cross(&self.pad, self.pad_width, nx, ny, t, &mut self.cross);
+        self.score(w, t);
+        Ok(&self.scores)
+    }
+
+    /// Placements per row and rows of placements of the last correlation.
+    pub fn placements(&self) -> (usize, usize) {
+        (self.nx, self.ny)
+    }
+
+    /// The best placement of `t` in `window`.
+    pub fn best(&mut self, img: &Gray<'_>, window: Rect, t: &Template) -> Result<Match, VisionError> {
+        self.correlate(img, window, t)?;
+        let (nx, ny) = (self.nx, self.ny);
+        let (i, score) = self
+            .scores
+            .iter()
+            .copied()
+            .enumerate()
+            .fold((0, f32::MIN), |b, (i, s)| if s > b.1 { (i, s) } else { b });
+        let (px, py) = (i % nx, i / nx);
+        let at = |x: usize, y: usize| self.scores[y * nx + x];
+        let vertex = |a: f32, b: f32, c: f32| {
+            let d = a - 2.0 * b + c;
+            if d < 0.0 { (0.5 * (a - c) / d).clamp(-0.5, 0.5) } else { 0.0 }
+        };
+        let dx = if px > 0 && px + 1 < nx { vertex(at(px - 1, py), score, at(px + 1, py)) } else { 0.0 };
+        let dy = if py > 0 && py + 1 < ny { vertex(at(px, py - 1), score, at(px, py + 1)) } else { 0.0 };
+        let (x, y) = (window.x0 + px, window.y0 + py);
+        let centre = [x as f32 + t.width as f32 / 2.0 + dx, y as f32 + t.height as f32 / 2.0 + dy];
+        Ok(Match { x, y, centre, score })
+    }
+
+    /// The window's pixels in rows padded with zeros, so that whole blocks can be read past the
+    /// last placement.
+    fn copy_padded(&mut self, img: &Gray<'_>, w: Rect, t: &Template) {
+        let (nx, ny) = (self.nx, self.ny);
+        self.pad_width = nx.next_multiple_of(BLOCK_X) + 4 * t.groups + 32;
+        let rows = ny.next_multiple_of(BLOCK_Y) + t.height + BLOCK_Y;
+        self.pad.clear();
+        self.pad.resize(self.pad_width * rows, 0);
+        for (i, y) in (w.y0..w.y1).enumerate() {
+            self.pad[i * self.pad_width..i * self.pad_width + w.width()]
+                .copy_from_slice(&img.row(y)[w.x0..w.x1]);
+        }
+    }
+
+    /// Scores row by row: column sums over the template's height slide down a row at a time,
+    /// running sums along the row give each placement's `S_P` and `ΣP²` as a difference.
+    fn score(&mut self, w: Rect, t: &Template) {
+        let (nx, ny, ww, pw) = (self.nx, self.ny, w.width(), self.pad_width);
+        let cross_stride = nx.next_multiple_of(BLOCK_X);
+        self.scores.clear();
+        self.scores.resize(nx * ny, 0.0);
+        for v in [&mut self.col_sums, &mut self.col_squares] {
+            v.clear();
+            v.resize(ww, 0);
+        }
+        for v in [&mut self.run_sums, &mut self.run_squares] {
+            v.clear();
+            v.resize(ww + 1, 0);
+        }
+        for r in 0..t.height {
+            add_row(&mut self.col_sums, &mut self.col_squares, &self.pad[r * pw..r * pw + ww]);
+        }
+        for y in 0..ny {
+            if y > 0 {
+                let (old, new) = ((y - 1) * pw, (y - 1 + t.height) * pw);
+                slide_row(
+                    &mut self.col_sums,
+                    &mut self.col_squares,
+                    &self.pad[old..old + ww],
+                    &self.pad[new..new + ww],
+                );
+            }
+            running(&self.col_sums, &mut self.run_sums[1..]);
+            running(&self.col_squares, &mut self.run_squares[1..]);
+            let sums = RowSums {
+                run: &self.run_sums,
+                squares: &self.run_squares,
+                cross: &self.cross[y * cross_stride..],
+            };
+            let out = &mut self.scores[y * nx..(y + 1) * nx];
+            #[cfg(target_arch = "x86_64")]
+            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                // SAFETY: the features are present.
+                unsafe { score_row_avx2(sums, t, out) };
+                continue;
+            }
+            score_row(sums, t, out);
+        }
+    }
+}
+
+fn add_row(sums: &mut [u32], squares: &mut [u32], row: &[u8]) {
+    for ((s, q), &p) in sums.iter_mut().zip(squares.iter_mut()).zip(row) {
+        *s += u32::from(p);
+        *q += u32::from(p) * u32::from(p);
+    }
+}
+
+fn slide_row(sums: &mut [u32], squares: &mut [u32], old: &[u8], new: &[u8]) {
+    for (((s, q), &o), &n) in sums.iter_mut().zip(squares.iter_mut()).zip(old).zip(new) {
+        *s = s.wrapping_add(u32::from(n)).wrapping_sub(u32::from(o));
+        *q = q.wrapping_add(u32::from(n) * u32::from(n)).wrapping_sub(u32::from(o) * u32::from(o));
+    }
+}
+
+/// One row of placements' running sums and cross sums.
+struct RowSums<'a> {
+    run: &'a [u32],
+    squares: &'a [u32],
+    cross: &'a [i32],
+}
+
+/// Running (wrapping) sums of `v` into `out`.
+fn running(v: &[u32], out: &mut [u32]) {
+    let mut acc = 0u32;
+    for (o, &x) in out.iter_mut().zip(v) {
+        acc = acc.wrapping_add(x);
+        *o = acc;
+    }
+}
+
+/// [`score_row`] compiled for AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn score_row_avx2(r: RowSums<'_>, t: &Template, out: &mut [f32]) {
+    score_row(r, t, out)
+}
+
+/// NC for one row of placements. Window sums stay below 2^31 (at most 128 x 128 x 255²), so
+/// they convert as `i32`, which vectorises.
+#[inline(always)]
+fn score_row(r: RowSums<'_>, t: &Template, out: &mut [f32]) {
+    let (st, stt, tw) = (t.sum as f32, t.sum_sq as f32, t.width);
+    let st2 = st * st;
+    let n = out.len();
+    let (lo, hi) = (&r.run[..n], &r.run[tw..tw + n]);
+    let (qlo, qhi) = (&r.squares[..n], &r.squares[tw..tw + n]);
+    let cross = &r.cross[..n];
+    for (x, o) in out.iter_mut().enumerate() {
+        let sp = hi[x].wrapping_sub(lo[x]) as i32 as f32;
+        let spp = qhi[x].wrapping_sub(qlo[x]) as i32 as f32;
+        let spt = cross[x] as f32 + 128.0 * sp;
+        // A black patch (S_P = 0) has numerator 0 too: it scores 0.
+        let den = (spp * st2 + stt * sp * sp).max(f32::MIN_POSITIVE);
+        *o = 2.0 * spt * sp * st / den;
+    }
+}
+
+/// `Σ P (T - 128)` for every placement, into `out` (row stride `nx` rounded up to a block).
+fn cross(pad: &[u8], pw: usize, nx: usize, ny: usize, t: &Template, out: &mut [i32]) {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx512f")
+        && std::is_x86_feature_detected!("avx512bw")
+        && std::is_x86_feature_detected!("avx512vnni")
+    {
+        // SAFETY: the features are present, and `copy_padded` sized `pad` for whole blocks.
+        unsafe { crate::simd::cross_avx512(pad, pw, nx, ny, &t.packed, t.groups, t.height, out) };
+        return;
+    }
+    cross_portable(pad, pw, nx, ny, t, out);
+}
+
+/// The portable form of [`cross`]: one pass per template byte over a row of placements.
+pub(crate) fn cross_portable(pad: &[u8], pw: usize, nx: usize, ny: usize, t: &Template, out: &mut [i32]) {
+    let stride = nx.next_multiple_of(BLOCK_X);
+    for y in 0..ny {
+        let acc = &mut out[y * stride..y * stride + nx];
+        for r in 0..t.height {
+            let row = &pad[(y + r) * pw..];
+            for g in 0..t.groups {
+                let word = t.packed[r * t.groups + g];
+                for b in 0..4 {
+                    let tv = i32::from((word >> (8 * b)) as i8);
+                    if tv == 0 {
+                        continue;
+                    }
+                    let src = &row[4 * g + b..4 * g + b + nx];
+                    for (a, &p) in acc.iter_mut().zip(src) {
+                        *a += tv * i32::from(p);
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A textured test image: smooth shading plus a pseudo-random pattern.
+    fn scene(w: usize, h: usize) -> GrayBuf {
+        GrayBuf::from_fn(w, h, |x, y| {
+            let n = (x.wrapping_mul(7919) ^ y.wrapping_mul(104_729)).wrapping_mul(2_654_435_761) >> 7;
+            (40 + (x + y) / 8 % 60 + n % 120) as u8
+        })
+    }
+
+    /// The formula itself, in f64, placement by placement.
+    fn reference(img: &Gray<'_>, win: Rect, t: &GrayBuf) -> Vec<f64> {
+        let st: f64 = t.data.iter().map(|&v| f64::from(v)).sum();
+        let mut out = Vec::new();
+        for y in win.y0..=win.y1 - t.height {
+            for x in win.x0..=win.x1 - t.width {
+                let sp: f64 = (0..t.height)
+                    .flat_map(|r| (0..t.width).map(move |c| (r, c)))
+                    .map(|(r, c)| f64::from(img.at(x + c, y + r)))
+                    .sum();
+                let (mut pt, mut pp, mut tt) = (0.0, 0.0, 0.0);
+                for r in 0..t.height {
+                    for c in 0..t.width {
+                        let rp = f64::from(img.at(x + c, y + r)) / sp;
+                        let rt = f64::from(t.data[r * t.width + c]) / st;
+                        (pt, pp, tt) = (pt + rp * rt, pp + rp * rp, tt + rt * rt);
+                    }
+                }
+                out.push(2.0 * pt / (pp + tt));
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn scores_match_the_formula_on_every_path() {
+        let img = scene(97, 61);
+        for (tw, th) in [(16, 16), (7, 5), (13, 9)] {
+            let t = GrayBuf::crop(&img.view(), Rect::new(30, 20, 30 + tw, 20 + th)).expect("crop");
+            let tmpl = Template::new(&t).expect("template");
+            let win = Rect::new(3, 2, 90, 58);
+            let want = reference(&img.view(), win, &t);
+            let mut c = Correlator::default();
+            let got = c.correlate(&img.view(), win, &tmpl).expect("correlates").to_vec();
+            assert_eq!(got.len(), want.len());
+            for (g, w) in got.iter().zip(&want) {
+                assert!((f64::from(*g) - w).abs() < 1e-4, "{tw}x{th}: {g} vs {w}");
+            }
+            // The portable sums equal the ones the CPU-specific path produced.
+            let mut portable = vec![0; c.cross.len()];
+            let (nx, ny) = c.placements();
+            cross_portable(&c.pad, c.pad_width, nx, ny, &tmpl, &mut portable);
+            let stride = nx.next_multiple_of(BLOCK_X);
+            for y in 0..ny {
+                assert_eq!(&portable[y * stride..y * stride + nx], &c.cross[y * stride..y * stride + nx]);
+            }
+        }
+    }
+
+    #[test]
+    fn the_peak_is_where_the_template_was_cut_whatever_the_illumination() {
+        let img = scene(120, 90);
+        let t = GrayBuf::crop(&img.view(), Rect::new(50, 40, 66, 56)).expect("crop");
+        // Half the light: reflectance normalisation makes no difference.
+        let dim = GrayBuf { data: t.data.iter().map(|v| v / 2).collect(), ..t.clone() };
+        let mut c = Correlator::default();
+        for tmpl in [&t, &dim] {
+            let m = c.best(&img.view(), img.view().full(), &Template::new(tmpl).expect("t")).expect("best");
+            assert_eq!((m.x, m.y), (50, 40));
+            assert!(m.score > 0.995, "{}", m.score);
+            assert!((m.centre[0] - 58.0).abs() <= 0.5 && (m.centre[1] - 48.0).abs() <= 0.5, "{:?}", m.centre);
+        }
+    }
+
+    #[test]
+    fn bad_requests_are_errors() {
+        let img = scene(64, 48);
+        let t = Template::new(&GrayBuf::from_fn(16, 16, |x, _| x as u8 + 1)).expect("t");
+        let mut c = Correlator::default();
+        let outside = c.correlate(&img.view(), Rect::new(50, 0, 70, 20), &t).expect_err("outside");
+        assert_eq!(outside, VisionError::WindowOutside(Rect::new(50, 0, 70, 20), 64, 48));
+        assert!(matches!(
+            c.correlate(&img.view(), Rect::new(0, 0, 10, 40), &t),
+            Err(VisionError::TemplateTooLarge(..))
+        ));
+        assert_eq!(Template::new(&GrayBuf::new(0, 0)).expect_err("empty"), VisionError::EmptyTemplate);
+        assert!(Template::new(&GrayBuf::new(4, 4)).is_err(), "all black");
+    }
+}
