@@ -13,6 +13,7 @@ use std::time::Instant;
 
 use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
+use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect};
 
@@ -110,6 +111,23 @@ fn bench_nc(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     }
 }
 
+fn bench_moravec(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
+    let p = MoravecParams::default();
+    let mut m = Moravec::default();
+    let win = around(textured(img, 16), 64);
+    for (scope, win) in [("full frame".to_owned(), img.full()), ("64x64 window".to_owned(), win)] {
+        let ours = m.corners(img, win, &p).expect("runs").len();
+        assert!(ours > 0, "no corner found in {scope}");
+        let harvey_us = time(|| {
+            black_box(m.corners(img, win, &p).expect("runs").len());
+        });
+        let reference_us = time(|| {
+            black_box(reference::moravec(img, win, p.window, p.threshold, p.suppress_radius));
+        });
+        rows.push(Row { kernel: "Moravec 5x5", size: size.to_owned(), scope, harvey_us, reference_us });
+    }
+}
+
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let world = harvey_world::World::load(&root.join("worlds/hallway.toml")).expect("world");
@@ -121,6 +139,7 @@ fn main() {
         write_pgm(&out.join(format!("frame_{w}x{h}.pgm")), &img);
         let size = format!("{w}x{h}");
         bench_nc(&img.view(), &size, &mut rows);
+        bench_moravec(&img.view(), &size, &mut rows);
     }
     println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
     println!("|---|---|---|---:|---:|---:|");

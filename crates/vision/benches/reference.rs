@@ -33,3 +33,57 @@ pub fn nc_best(img: &Gray<'_>, win: Rect, t: &GrayBuf) -> (usize, usize, f64) {
     }
     best
 }
+
+/// The Moravec operator pixel by pixel: four shifted window sums, their minimum, then local
+/// maxima by scanning every neighbourhood.
+pub fn moravec(
+    img: &Gray<'_>,
+    win: Rect,
+    k: usize,
+    threshold: u32,
+    radius: usize,
+) -> Vec<(usize, usize, u32)> {
+    let h = (k / 2) as isize;
+    let (ww, wh) = (win.width(), win.height());
+    let mut map = vec![0u32; ww * wh];
+    let m = k / 2 + 1;
+    for y in m..wh.saturating_sub(m) {
+        for x in m..ww.saturating_sub(m) {
+            let mut best = u32::MAX;
+            for (dx, dy) in [(1isize, 0isize), (0, 1), (1, 1), (1, -1)] {
+                let mut s = 0u32;
+                for j in -h..=h {
+                    for i in -h..=h {
+                        let (px, py) = ((win.x0 + x) as isize + i, (win.y0 + y) as isize + j);
+                        let d = i32::from(img.at(px as usize, py as usize))
+                            - i32::from(img.at((px + dx) as usize, (py + dy) as usize));
+                        s += (d * d) as u32;
+                    }
+                }
+                best = best.min(s);
+            }
+            map[y * ww + x] = best;
+        }
+    }
+    let mut out = Vec::new();
+    for y in 0..wh {
+        for x in 0..ww {
+            let v = map[y * ww + x];
+            if v < threshold {
+                continue;
+            }
+            let mut peak = true;
+            for j in y.saturating_sub(radius)..=(y + radius).min(wh - 1) {
+                for i in x.saturating_sub(radius)..=(x + radius).min(ww - 1) {
+                    if (i, j) != (x, y) && map[j * ww + i] > v {
+                        peak = false;
+                    }
+                }
+            }
+            if peak {
+                out.push((win.x0 + x, win.y0 + y, v));
+            }
+        }
+    }
+    out
+}
