@@ -71,7 +71,7 @@ impl Moravec {
         p: &MoravecParams,
     ) -> Result<&[u32], VisionError> {
         let w = window.inside(img.width, img.height)?;
-        if p.window % 2 == 0 || !(3..=9).contains(&p.window) {
+        if p.window.is_multiple_of(2) || !(3..=9).contains(&p.window) {
             return Err(VisionError::BadParameter(format!(
                 "Moravec window {} is not odd in 3..=9",
                 p.window
