@@ -13,6 +13,7 @@ use std::time::Instant;
 
 use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
+use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect};
@@ -82,8 +83,10 @@ fn textured(img: &Gray<'_>, side: usize) -> Rect {
     Rect::new(x, y, x + side, y + side)
 }
 
-fn around(r: Rect, side: usize) -> Rect {
-    let (x0, y0) = (r.x0 + r.width() / 2 - side / 2, r.y0 + r.height() / 2 - side / 2);
+/// A `side`-pixel square centred on `r`, moved inside the image.
+fn around(img: &Gray<'_>, r: Rect, side: usize) -> Rect {
+    let centre = |a: usize, len: usize, max: usize| (a + len / 2).saturating_sub(side / 2).min(max - side);
+    let (x0, y0) = (centre(r.x0, r.width(), img.width), centre(r.y0, r.height(), img.height));
     Rect::new(x0, y0, x0 + side, y0 + side)
 }
 
@@ -92,7 +95,9 @@ fn bench_nc(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     let t = GrayBuf::crop(img, tr).expect("template");
     let tmpl = Template::new(&t).expect("template");
     let mut c = Correlator::default();
-    for (scope, win) in [("full frame".to_owned(), img.full()), ("48x48 window".to_owned(), around(tr, 48))] {
+    for (scope, win) in
+        [("full frame".to_owned(), img.full()), ("48x48 window".to_owned(), around(img, tr, 48))]
+    {
         let m = c.best(img, win, &tmpl).expect("correlates");
         assert_eq!((m.x, m.y), (tr.x0, tr.y0), "the template is found where it was cut");
         let harvey_us = time(|| {
@@ -114,7 +119,7 @@ fn bench_nc(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
 fn bench_moravec(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     let p = MoravecParams::default();
     let mut m = Moravec::default();
-    let win = around(textured(img, 16), 64);
+    let win = around(img, textured(img, 16), 64);
     for (scope, win) in [("full frame".to_owned(), img.full()), ("64x64 window".to_owned(), win)] {
         let ours = m.corners(img, win, &p).expect("runs").len();
         assert!(ours > 0, "no corner found in {scope}");
@@ -125,6 +130,22 @@ fn bench_moravec(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
             black_box(reference::moravec(img, win, p.window, p.threshold, p.suppress_radius));
         });
         rows.push(Row { kernel: "Moravec 5x5", size: size.to_owned(), scope, harvey_us, reference_us });
+    }
+}
+
+fn bench_flf(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
+    let p = FlfParams::default();
+    let mut f = Flf::default();
+    let win = around(img, textured(img, 16), 96);
+    for (scope, win) in [("full frame".to_owned(), img.full()), ("96x96 window".to_owned(), win)] {
+        assert!(!f.lines(img, win, &p).expect("runs").is_empty(), "no line in {scope}");
+        let harvey_us = time(|| {
+            black_box(f.lines(img, win, &p).expect("runs").len());
+        });
+        let reference_us = time(|| {
+            black_box(reference::flf(img, win, p.buckets, p.min_gradient, f64::from(p.min_length)));
+        });
+        rows.push(Row { kernel: "fast line finder", size: size.to_owned(), scope, harvey_us, reference_us });
     }
 }
 
@@ -140,6 +161,7 @@ fn main() {
         let size = format!("{w}x{h}");
         bench_nc(&img.view(), &size, &mut rows);
         bench_moravec(&img.view(), &size, &mut rows);
+        bench_flf(&img.view(), &size, &mut rows);
     }
     println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
     println!("|---|---|---|---:|---:|---:|");

@@ -87,3 +87,67 @@ pub fn moravec(
     }
     out
 }
+
+/// The line finder the plain way: atan2 per pixel, pixel-by-pixel union-find over a label
+/// image, moments accumulated pixel by pixel, one partition. Returns the number of lines.
+pub fn flf(img: &Gray<'_>, win: Rect, buckets: u8, min_gradient: f32, min_length: f64) -> usize {
+    let (w, h) = (win.width() - 1, win.height() - 1);
+    let mut bucket = vec![0u8; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let p = |i: usize, j: usize| f32::from(img.at(win.x0 + x + i, win.y0 + y + j));
+            let gx = (p(1, 0) + p(1, 1) - p(0, 0) - p(0, 1)) / 2.0;
+            let gy = (p(0, 1) + p(1, 1) - p(0, 0) - p(1, 0)) / 2.0;
+            if (gx * gx + gy * gy).sqrt() >= min_gradient {
+                let dir = gy.atan2(gx).to_degrees().rem_euclid(360.0);
+                bucket[y * w + x] = (dir / (360.0 / f32::from(buckets))) as u8 % buckets + 1;
+            }
+        }
+    }
+    let mut parent: Vec<usize> = (0..w * h).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    for y in 0..h {
+        for x in 0..w {
+            let b = bucket[y * w + x];
+            if b == 0 {
+                continue;
+            }
+            for (dx, dy) in [(-1isize, 0isize), (-1, -1), (0, -1), (1, -1)] {
+                let (nx, ny) = (x as isize + dx, y as isize + dy);
+                if nx >= 0 && ny >= 0 && (nx as usize) < w && bucket[ny as usize * w + nx as usize] == b {
+                    let (a, c) =
+                        (root(&mut parent, y * w + x), root(&mut parent, ny as usize * w + nx as usize));
+                    parent[a.max(c)] = a.min(c);
+                }
+            }
+        }
+    }
+    let mut sums = std::collections::HashMap::<usize, [f64; 6]>::new();
+    for y in 0..h {
+        for x in 0..w {
+            if bucket[y * w + x] != 0 {
+                let r = root(&mut parent, y * w + x);
+                let s = sums.entry(r).or_default();
+                let (fx, fy) = (x as f64, y as f64);
+                for (k, v) in [1.0, fx, fy, fx * fx, fx * fy, fy * fy].into_iter().enumerate() {
+                    s[k] += v;
+                }
+            }
+        }
+    }
+    sums.values()
+        .filter(|s| {
+            let n = s[0];
+            let (mx, my) = (s[1] / n, s[2] / n);
+            let (cxx, cxy, cyy) = (s[3] / n - mx * mx, s[4] / n - mx * my, s[5] / n - my * my);
+            let l1 = (cxx + cyy) / 2.0 + (((cxx - cyy) / 2.0).powi(2) + cxy * cxy).sqrt();
+            (12.0 * l1 + 1.0).sqrt() >= min_length
+        })
+        .count()
+}

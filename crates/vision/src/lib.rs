@@ -2,9 +2,11 @@
 //! or a state machine with reusable buffers, no IO, no clock. The vision-workers service runs them
 //! on camera frames in shared memory, inside the windows it is asked to look in.
 
+pub mod flf;
 pub mod image;
 pub mod moravec;
 pub mod nc;
+pub mod regions;
 mod simd;
 
 pub use image::{Gray, GrayBuf, Rect, VisionError};

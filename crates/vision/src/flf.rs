@@ -1,0 +1,317 @@
+//! The fast line finder (001 §2.1, after Burns, Hanson and Riseman; Kahn, Kitchen and Riseman):
+//! pixels are grouped by coarsely quantised gradient orientation into edge-support regions
+//! (connected components), and one line is fitted to each region with its statistics; lines
+//! are then filtered on length, gradient magnitude, dispersion and orientation.
+//!
+//! Buckets can be tuned (their count and the orientation the first starts at). With
+//! `overlap`, a second partition shifted by half a bucket runs too and every pixel votes for
+//! the longer of its two regions, so a line that straddles a bucket boundary is not broken
+//! (Burns' overlapping partitions).
+//!
+//! Regions are built from runs of equal bucket along rows joined by union-find, and their
+//! moments come from closed forms over each run, so the work is per run, not per pixel.
+
+use crate::image::{Gray, Rect, VisionError};
+use crate::regions::{Moments, Runs, cell_gradient};
+
+/// Settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FlfParams {
+    /// Orientation buckets over 360 degrees of gradient direction (2 to 15).
+    pub buckets: u8,
+    /// Gradient direction where the first bucket starts (tune a bucket onto an expected line).
+    pub offset_deg: f32,
+    /// Second partition shifted by half a bucket, pixels voting for their longer region.
+    pub overlap: bool,
+    /// Gradient magnitude (grey levels per pixel) below which a pixel supports no line.
+    pub min_gradient: f32,
+    /// Filters on the fitted lines.
+    pub min_length: f32,
+    pub min_mean_gradient: f32,
+    /// Largest spread across the line (standard deviation, pixels).
+    pub max_dispersion: f32,
+    /// Keep only lines whose direction (0..180 degrees, image x to the right, y down) lies in
+    /// this range; `None` keeps all.
+    pub orientation_deg: Option<(f32, f32)>,
+}
+
+impl Default for FlfParams {
+    fn default() -> Self {
+        Self {
+            buckets: 8,
+            offset_deg: 0.0,
+            overlap: true,
+            min_gradient: 8.0,
+            min_length: 10.0,
+            min_mean_gradient: 12.0,
+            max_dispersion: 2.0,
+            orientation_deg: None,
+        }
+    }
+}
+
+/// A fitted line with its region's statistics.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Line {
+    pub from: [f32; 2],
+    pub to: [f32; 2],
+    pub length: f32,
+    /// Direction of the line, 0..180 degrees.
+    pub orientation_deg: f32,
+    pub mean_gradient: f32,
+    /// Standard deviation of the support across the line.
+    pub dispersion: f32,
+    pub pixels: u32,
+}
+
+/// The line finder with its buffers and its orientation look-up table.
+#[derive(Debug, Default)]
+pub struct Flf {
+    lut: Vec<u8>,
+    lut_key: Option<(u8, u32, bool, u32)>,
+    labels: Vec<u8>,
+    gradients: Vec<i16>,
+    runs: [Runs; 2],
+    moments: [Vec<Moments>; 2],
+    lengths: [Vec<f32>; 2],
+    votes: Vec<u32>,
+    lines: Vec<Line>,
+}
+
+/// Gradient components are halved sums of a 2x2 cell, in -255..=255.
+const G: i32 = 255;
+const SIDE: usize = (2 * G + 1) as usize;
+
+impl Flf {
+    /// The lines in `window`, longest first.
+    pub fn lines(&mut self, img: &Gray<'_>, window: Rect, p: &FlfParams) -> Result<&[Line], VisionError> {
+        let w = window.inside(img.width, img.height)?;
+        if !(2..=15).contains(&p.buckets) || !p.offset_deg.is_finite() || !(p.min_gradient >= 0.0) {
+            return Err(VisionError::BadParameter(format!(
+                "FLF buckets {} (2..=15), offset, gradient",
+                p.buckets
+            )));
+        }
+        self.build_lut(p);
+        self.lines.clear();
+        if w.width() < 2 || w.height() < 2 {
+            return Ok(&self.lines);
+        }
+        self.label(img, w, p);
+        let (ww, wh) = (w.width() - 1, w.height() - 1);
+        let partitions = if p.overlap { 2 } else { 1 };
+        for k in 0..partitions {
+            let shift = 4 * k as u32;
+            self.runs[k].build(&self.labels, ww, wh, |b| (b >> shift) & 0x0f);
+            // Cell (x, y) lies between pixels x, x + 1 and rows y, y + 1: centred on the pixel
+            // corner (w.x0 + x + 1, w.y0 + y + 1).
+            let origin = [w.x0 as f64 + 1.0, w.y0 as f64 + 1.0];
+            self.runs[k].moments(origin, &mut self.moments[k], |x, y| cell_gradient(img, w.x0 + x, w.y0 + y));
+            self.lengths[k].clear();
+            self.lengths[k].extend(self.moments[k].iter().map(|m| m.line().map_or(0.0, |l| l.length)));
+        }
+        // Every region starts with all its pixels' votes; with overlap, each pixel covered by
+        // regions of both partitions takes its vote from the shorter one.
+        self.votes.clear();
+        for k in 0..partitions {
+            self.votes.extend(self.moments[k].iter().map(|m| m.n as u32));
+        }
+        if p.overlap {
+            let n0 = self.moments[0].len();
+            let (lengths, votes) = (&self.lengths, &mut self.votes);
+            Runs::overlaps(&self.runs[0], &self.runs[1], |a, b, len| {
+                if lengths[0][a] >= lengths[1][b] {
+                    votes[n0 + b] -= len;
+                } else {
+                    votes[a] -= len;
+                }
+            });
+        }
+        let mut idx = 0;
+        for k in 0..partitions {
+            for m in &self.moments[k] {
+                let votes = self.votes[idx];
+                idx += 1;
+                if 2 * votes as usize <= m.n as usize {
+                    continue;
+                }
+                if let Some(l) = m.line().filter(|l| keep(l, p)) {
+                    self.lines.push(l);
+                }
+            }
+        }
+        self.lines.sort_by(|a, b| b.length.total_cmp(&a.length));
+        Ok(&self.lines)
+    }
+
+    /// Bucket of every gradient (or 0 when too weak), both partitions in one byte.
+    fn build_lut(&mut self, p: &FlfParams) {
+        let key = (p.buckets, p.offset_deg.to_bits(), p.overlap, p.min_gradient.to_bits());
+        if self.lut_key == Some(key) {
+            return;
+        }
+        self.lut_key = Some(key);
+        self.lut.clear();
+        self.lut.resize(SIDE * SIDE, 0);
+        let width = 360.0 / f32::from(p.buckets);
+        let min2 = p.min_gradient * p.min_gradient;
+        for gy in -G..=G {
+            for gx in -G..=G {
+                let (fx, fy) = (gx as f32, gy as f32);
+                if fx * fx + fy * fy < min2.max(1.0) {
+                    continue;
+                }
+                let dir = fy.atan2(fx).to_degrees();
+                let bucket = |offset: f32| ((dir - offset).rem_euclid(360.0) / width) as u8 % p.buckets + 1;
+                let a = bucket(p.offset_deg);
+                let b = if p.overlap { bucket(p.offset_deg + width / 2.0) } else { 0 };
+                self.lut[((gy + G) as usize) * SIDE + (gx + G) as usize] = a | (b << 4);
+            }
+        }
+    }
+
+    /// The bucket byte of each 2x2 cell of the window: `(width - 1) x (height - 1)`.
+    fn label(&mut self, img: &Gray<'_>, w: Rect, p: &FlfParams) {
+        let (ww, wh) = (w.width() - 1, w.height() - 1);
+        self.labels.clear();
+        self.labels.resize(ww * wh, 0);
+        self.gradients.clear();
+        self.gradients.resize(2 * ww, 0);
+        let strong = (p.min_gradient * p.min_gradient).max(1.0).ceil() as i32;
+        let (lut, labels, g) = (&self.lut, &mut self.labels, &mut self.gradients);
+        #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2.
+            unsafe { label_avx2(img, w, strong, lut, labels, g) };
+            return;
+        }
+        label_rows(img, w, strong, lut, labels, g);
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn label_avx2(img: &Gray<'_>, w: Rect, strong: i32, lut: &[u8], labels: &mut [u8], g: &mut [i16]) {
+    label_rows(img, w, strong, lut, labels, g)
+}
+
+/// Per row: the gradients and a strong-or-not mark for every cell (vectorised), then the
+/// look-up for the strong cells only, skipping weak ones eight at a time.
+#[inline(always)]
+fn label_rows(img: &Gray<'_>, w: Rect, strong: i32, lut: &[u8], labels: &mut [u8], g: &mut [i16]) {
+    let (ww, wh) = (w.width() - 1, w.height() - 1);
+    let (gxs, gys) = g.split_at_mut(ww);
+    for y in 0..wh {
+        let (r0, r1) = (&img.row(w.y0 + y)[w.x0..w.x1], &img.row(w.y0 + y + 1)[w.x0..w.x1]);
+        let out = &mut labels[y * ww..(y + 1) * ww];
+        for x in 0..ww {
+            let (a, b, c, d) =
+                (i32::from(r0[x]), i32::from(r0[x + 1]), i32::from(r1[x]), i32::from(r1[x + 1]));
+            let gx = (b + d - a - c) / 2;
+            let gy = (c + d - a - b) / 2;
+            gxs[x] = gx as i16;
+            gys[x] = gy as i16;
+            out[x] = u8::from(gx * gx + gy * gy >= strong);
+        }
+        let mut x = 0;
+        while x < ww {
+            if x + 8 <= ww && out[x..x + 8].iter().all(|&v| v == 0) {
+                x += 8;
+                continue;
+            }
+            if out[x] != 0 {
+                let (gx, gy) = (i32::from(gxs[x]), i32::from(gys[x]));
+                out[x] = lut[((gy + G) as usize) * SIDE + (gx + G) as usize];
+            }
+            x += 1;
+        }
+    }
+}
+
+fn keep(l: &Line, p: &FlfParams) -> bool {
+    let in_range = |(lo, hi): (f32, f32)| {
+        let o = l.orientation_deg;
+        if lo <= hi { (lo..=hi).contains(&o) } else { o >= lo || o <= hi }
+    };
+    l.length >= p.min_length
+        && l.mean_gradient >= p.min_mean_gradient
+        && l.dispersion <= p.max_dispersion
+        && p.orientation_deg.is_none_or(in_range)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::image::GrayBuf;
+
+    /// A dark ground with a bright convex region where `inside(x, y)`, anti-aliased by 4x4
+    /// supersampling so slanted edges are clean.
+    fn shape(w: usize, h: usize, inside: impl Fn(f32, f32) -> bool) -> GrayBuf {
+        GrayBuf::from_fn(w, h, |x, y| {
+            let n = (0..16)
+                .filter(|k| {
+                    inside(x as f32 + (k % 4) as f32 / 4.0 + 0.125, y as f32 + (k / 4) as f32 / 4.0 + 0.125)
+                })
+                .count();
+            (40 + n * 160 / 16) as u8
+        })
+    }
+
+    #[test]
+    fn the_sides_of_a_rectangle_come_out_with_their_endpoints() {
+        let img = shape(120, 100, |x, y| (30.0..90.0).contains(&x) && (20.0..80.0).contains(&y));
+        let mut f = Flf::default();
+        let lines = f.lines(&img.view(), img.view().full(), &FlfParams::default()).expect("runs").to_vec();
+        assert_eq!(lines.len(), 4, "{lines:#?}");
+        // The left side: the edge between columns 29 and 30 is x = 30, from y = 20 to 80.
+        let left = lines.iter().find(|l| l.from[0] < 35.0 && l.to[0] < 35.0).expect("left side");
+        assert!((left.orientation_deg - 90.0).abs() < 1.0, "{left:?}");
+        assert!((left.from[0] - 30.0).abs() < 0.6 && (left.to[0] - 30.0).abs() < 0.6, "{left:?}");
+        let (top, bottom) = (left.from[1].min(left.to[1]), left.from[1].max(left.to[1]));
+        assert!((top - 20.0).abs() < 2.0 && (bottom - 80.0).abs() < 2.0, "{left:?}");
+        assert!(left.mean_gradient > 60.0 && left.dispersion < 1.0, "{left:?}");
+    }
+
+    #[test]
+    fn overlapping_partitions_keep_a_line_on_a_bucket_boundary_whole() {
+        // An edge whose gradient points at 45 degrees, exactly on a boundary of 8 buckets from 0;
+        // a little sensor noise puts its pixels on either side of the boundary.
+        let clean = shape(100, 100, |x, y| x + y > 100.0);
+        let noise = |i: usize| ((i.wrapping_mul(2_654_435_761) >> 13) % 9) as u8;
+        let img =
+            GrayBuf { data: clean.data.iter().enumerate().map(|(i, v)| v + noise(i)).collect(), ..clean };
+        let mut f = Flf::default();
+        let base = FlfParams { min_length: 5.0, ..FlfParams::default() };
+        let split = f
+            .lines(&img.view(), img.view().full(), &FlfParams { overlap: false, ..base })
+            .expect("runs")
+            .to_vec();
+        let whole = f.lines(&img.view(), img.view().full(), &base).expect("runs").to_vec();
+        let longest = |l: &[Line]| l.first().map_or(0.0, |l| l.length);
+        assert!(longest(&whole) > 120.0, "{whole:#?}");
+        assert!((whole[0].orientation_deg - 135.0).abs() < 1.0, "{:?}", whole[0]);
+        assert!(longest(&split) < 0.5 * longest(&whole), "{} vs {}", longest(&split), longest(&whole));
+    }
+
+    #[test]
+    fn windows_and_filters_choose_the_lines() {
+        let img = shape(120, 100, |x, y| (30.0..90.0).contains(&x) && (20.0..80.0).contains(&y));
+        let mut f = Flf::default();
+        // A window round the right side only.
+        let right =
+            f.lines(&img.view(), Rect::new(80, 10, 100, 90), &FlfParams::default()).expect("runs").to_vec();
+        assert_eq!(right.len(), 1, "{right:#?}");
+        assert!((right[0].from[0] - 90.0).abs() < 0.6, "{:?}", right[0]);
+        // Horizontal lines only.
+        let p = FlfParams { orientation_deg: Some((170.0, 10.0)), ..FlfParams::default() };
+        let flat = f.lines(&img.view(), img.view().full(), &p).expect("runs").to_vec();
+        assert_eq!(flat.len(), 2, "{flat:#?}");
+        assert!(flat.iter().all(|l| l.orientation_deg < 1.0 || l.orientation_deg > 179.0));
+        // Too weak an edge for the gradient filter.
+        let faint = shape(60, 60, |x, _| x > 30.0);
+        let faint = GrayBuf { data: faint.data.iter().map(|v| 100 + v / 32).collect(), ..faint };
+        assert!(f.lines(&faint.view(), faint.view().full(), &FlfParams::default()).expect("runs").is_empty());
+        let bad = FlfParams { buckets: 1, ..FlfParams::default() };
+        assert!(matches!(f.lines(&img.view(), img.view().full(), &bad), Err(VisionError::BadParameter(_))));
+    }
+}

@@ -1,0 +1,237 @@
+//! Connected regions from a class image, as runs: each row's runs of equal class are joined to
+//! the touching runs (8-connected) of the row above with union-find. Region moments come from
+//! closed forms over each run. Shared by the line finder and the region segmenter.
+
+use crate::flf::Line;
+use crate::image::Gray;
+
+/// A horizontal run of one class: row `y`, columns `x0 .. x1`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Run {
+    pub y: u32,
+    pub x0: u32,
+    pub x1: u32,
+    pub class: u8,
+    /// Index of its region, `0 .. regions` (after `build`).
+    pub region: u32,
+}
+
+/// The runs of a class image and the regions they form.
+#[derive(Debug, Default)]
+pub struct Runs {
+    pub runs: Vec<Run>,
+    pub regions: usize,
+    parent: Vec<u32>,
+    index: Vec<u32>,
+}
+
+fn find(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let up = parent[parent[i as usize] as usize];
+        parent[i as usize] = up;
+        i = up;
+    }
+    i
+}
+
+impl Runs {
+    /// Runs of `class_of(label)` (0: background) over a `w x h` label image, and their regions.
+    pub fn build(&mut self, labels: &[u8], w: usize, h: usize, class_of: impl Fn(u8) -> u8) {
+        self.runs.clear();
+        self.parent.clear();
+        let mut above = 0..0;
+        for y in 0..h {
+            let row = &labels[y * w..(y + 1) * w];
+            let start = self.runs.len();
+            let mut x = 0;
+            while x < w {
+                // Background (label 0) is the rule: skip it eight bytes at a time.
+                if x + 8 <= w && row[x..x + 8].iter().all(|&v| v == 0) {
+                    x += 8;
+                    continue;
+                }
+                let c = class_of(row[x]);
+                if c == 0 {
+                    x += 1;
+                    continue;
+                }
+                let x0 = x;
+                while x < w && class_of(row[x]) == c {
+                    x += 1;
+                }
+                let id = self.runs.len() as u32;
+                self.runs.push(Run { y: y as u32, x0: x0 as u32, x1: x as u32, class: c, region: 0 });
+                self.parent.push(id);
+            }
+            // Join with the touching runs above (diagonal contact counts).
+            let mut j = above.start;
+            for i in start..self.runs.len() {
+                let r = self.runs[i];
+                while j < above.end && self.runs[j].x1 < r.x0 {
+                    j += 1;
+                }
+                let mut k = j;
+                while k < above.end && self.runs[k].x0 <= r.x1 {
+                    if self.runs[k].class == r.class {
+                        let (a, b) = (find(&mut self.parent, i as u32), find(&mut self.parent, k as u32));
+                        if a != b {
+                            self.parent[a.max(b) as usize] = a.min(b);
+                        }
+                    }
+                    k += 1;
+                }
+            }
+            above = start..self.runs.len();
+        }
+        self.index.clear();
+        self.index.resize(self.runs.len(), u32::MAX);
+        self.regions = 0;
+        for i in 0..self.runs.len() {
+            let root = find(&mut self.parent, i as u32) as usize;
+            if self.index[root] == u32::MAX {
+                self.index[root] = self.regions as u32;
+                self.regions += 1;
+            }
+            self.runs[i].region = self.index[root];
+        }
+    }
+
+    /// Moments of every region; `value(x, y)` (run coordinates) is summed over its pixels.
+    /// Coordinates are offset by `origin` (where run cell (0, 0) lies in the image).
+    pub fn moments(
+        &self,
+        origin: [f64; 2],
+        out: &mut Vec<Moments>,
+        mut value: impl FnMut(usize, usize) -> f32,
+    ) {
+        out.clear();
+        out.resize(self.regions, Moments::default());
+        for r in &self.runs {
+            let m = &mut out[r.region as usize];
+            let (a, b) = (f64::from(r.x0) + origin[0], f64::from(r.x1) + origin[0]);
+            let y = f64::from(r.y) + origin[1];
+            let n = b - a;
+            // Σx and Σx² over x = a .. b-1.
+            let sx = (a + b - 1.0) * n / 2.0;
+            let s2 = |m: f64| m * (m + 1.0) * (2.0 * m + 1.0) / 6.0;
+            let sxx = s2(b - 1.0) - s2(a - 1.0);
+            m.n += n;
+            m.sx += sx;
+            m.sy += n * y;
+            m.sxx += sxx;
+            m.sxy += y * sx;
+            m.syy += n * y * y;
+            m.class = r.class;
+            m.x_min = m.x_min.min(a as f32);
+            m.x_max = m.x_max.max((b - 1.0) as f32);
+            m.y_min = m.y_min.min(y as f32);
+            m.y_max = m.y_max.max(y as f32);
+            let row = r.y as usize;
+            m.value += (r.x0 as usize..r.x1 as usize).map(|x| f64::from(value(x, row))).sum::<f64>();
+        }
+    }
+
+    /// Calls `f(region_in_a, region_in_b, pixels)` for every overlap of a run of `a` with a run
+    /// of `b` on the same row (both built over the same image).
+    pub fn overlaps(a: &Runs, b: &Runs, mut f: impl FnMut(usize, usize, u32)) {
+        let (mut i, mut j) = (0, 0);
+        while i < a.runs.len() && j < b.runs.len() {
+            let (p, q) = (a.runs[i], b.runs[j]);
+            if (p.y, p.x1) <= (q.y, q.x0) {
+                i += 1;
+                continue;
+            }
+            if (q.y, q.x1) <= (p.y, p.x0) {
+                j += 1;
+                continue;
+            }
+            let len = p.x1.min(q.x1) - p.x0.max(q.x0);
+            f(p.region as usize, q.region as usize, len);
+            if p.x1 <= q.x1 {
+                i += 1;
+            } else {
+                j += 1;
+            }
+        }
+    }
+}
+
+/// Sums over a region's pixels.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Moments {
+    pub n: f64,
+    pub sx: f64,
+    pub sy: f64,
+    pub sxx: f64,
+    pub sxy: f64,
+    pub syy: f64,
+    /// Sum of the per-pixel value (gradient magnitude, intensity).
+    pub value: f64,
+    pub class: u8,
+    pub x_min: f32,
+    pub x_max: f32,
+    pub y_min: f32,
+    pub y_max: f32,
+}
+
+impl Default for Moments {
+    fn default() -> Self {
+        Self {
+            n: 0.0,
+            sx: 0.0,
+            sy: 0.0,
+            sxx: 0.0,
+            sxy: 0.0,
+            syy: 0.0,
+            value: 0.0,
+            class: 0,
+            x_min: f32::MAX,
+            x_max: f32::MIN,
+            y_min: f32::MAX,
+            y_max: f32::MIN,
+        }
+    }
+}
+
+impl Moments {
+    pub fn centroid(&self) -> [f64; 2] {
+        [self.sx / self.n, self.sy / self.n]
+    }
+
+    /// The principal axis as a line: through the centroid, as long as a uniform segment with
+    /// the same spread (`sqrt(12 λ1 + 1)`, exact for a row of pixels), `dispersion` the spread
+    /// across it; `value` averaged over the pixels as its mean gradient.
+    pub fn line(&self) -> Option<Line> {
+        if self.n < 2.0 {
+            return None;
+        }
+        let [mx, my] = self.centroid();
+        let cxx = self.sxx / self.n - mx * mx;
+        let cyy = self.syy / self.n - my * my;
+        let cxy = self.sxy / self.n - mx * my;
+        let half = (cxx + cyy) / 2.0;
+        let root = (((cxx - cyy) / 2.0).powi(2) + cxy * cxy).sqrt();
+        let (l1, l2) = (half + root, (half - root).max(0.0));
+        let theta = 0.5 * (2.0 * cxy).atan2(cxx - cyy);
+        let length = (12.0 * l1 + 1.0).sqrt();
+        let (dx, dy) = (theta.cos() * length / 2.0, theta.sin() * length / 2.0);
+        Some(Line {
+            from: [(mx - dx) as f32, (my - dy) as f32],
+            to: [(mx + dx) as f32, (my + dy) as f32],
+            length: length as f32,
+            orientation_deg: (theta.to_degrees().rem_euclid(180.0)) as f32,
+            mean_gradient: (self.value / self.n) as f32,
+            dispersion: l2.sqrt() as f32,
+            pixels: self.n as u32,
+        })
+    }
+}
+
+/// Gradient magnitude of the 2x2 cell whose top-left pixel is `(x, y)`.
+#[inline]
+pub fn cell_gradient(img: &Gray<'_>, x: usize, y: usize) -> f32 {
+    let (a, b) = (f32::from(img.at(x, y)), f32::from(img.at(x + 1, y)));
+    let (c, d) = (f32::from(img.at(x, y + 1)), f32::from(img.at(x + 1, y + 1)));
+    let (gx, gy) = ((b + d - a - c) / 2.0, (c + d - a - b) / 2.0);
+    (gx * gx + gy * gy).sqrt()
+}
