@@ -86,7 +86,8 @@ impl Flf {
     /// The lines in `window`, longest first.
     pub fn lines(&mut self, img: &Gray<'_>, window: Rect, p: &FlfParams) -> Result<&[Line], VisionError> {
         let w = window.inside(img.width, img.height)?;
-        if !(2..=15).contains(&p.buckets) || !p.offset_deg.is_finite() || !(p.min_gradient.is_finite() && p.min_gradient >= 0.0) {
+        let usable = (2..=15).contains(&p.buckets) && p.offset_deg.is_finite() && p.min_gradient.is_finite();
+        if !usable || p.min_gradient < 0.0 {
             return Err(VisionError::BadParameter(format!(
                 "FLF buckets {} (2..=15), offset, gradient",
                 p.buckets
