@@ -14,6 +14,7 @@ use std::time::Instant;
 use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
 use harvey_vision::flf::{Flf, FlfParams};
+use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect};
@@ -149,6 +150,35 @@ fn bench_flf(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     }
 }
 
+fn bench_frs(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
+    // Three classes of grey: dark (door frames, skirting), mid (walls), bright (signs, lights).
+    let ranges = [
+        ClassRange { lo: 0, hi: 70, class: 1 },
+        ClassRange { lo: 71, hi: 170, class: 2 },
+        ClassRange { lo: 171, hi: 255, class: 3 },
+    ];
+    let plain: Vec<(u8, u8, u8)> = ranges.iter().map(|r| (r.lo, r.hi, r.class)).collect();
+    let mut f = Frs::default();
+    let win = around(img, textured(img, 16), 96);
+    for (scope, win) in [("full frame".to_owned(), img.full()), ("96x96 window".to_owned(), win)] {
+        let n = f.segment(img, win, &ranges, 20).expect("segments").len();
+        assert_eq!(n, reference::frs(img, win, &plain, 20), "region count in {scope}");
+        let harvey_us = time(|| {
+            black_box(f.segment(img, win, &ranges, 20).expect("segments").len());
+        });
+        let reference_us = time(|| {
+            black_box(reference::frs(img, win, &plain, 20));
+        });
+        rows.push(Row {
+            kernel: "fast region segmenter + stats",
+            size: size.to_owned(),
+            scope,
+            harvey_us,
+            reference_us,
+        });
+    }
+}
+
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let world = harvey_world::World::load(&root.join("worlds/hallway.toml")).expect("world");
@@ -162,6 +192,7 @@ fn main() {
         bench_nc(&img.view(), &size, &mut rows);
         bench_moravec(&img.view(), &size, &mut rows);
         bench_flf(&img.view(), &size, &mut rows);
+        bench_frs(&img.view(), &size, &mut rows);
     }
     println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
     println!("|---|---|---|---:|---:|---:|");

@@ -151,3 +151,54 @@ pub fn flf(img: &Gray<'_>, win: Rect, buckets: u8, min_gradient: f32, min_length
         })
         .count()
 }
+
+/// Region segmentation the plain way: classify every pixel by searching the ranges,
+/// pixel-by-pixel union-find (4 and diagonal neighbours), statistics accumulated pixel by
+/// pixel in a map. Returns the number of regions of at least `min_area` pixels.
+pub fn frs(img: &Gray<'_>, win: Rect, ranges: &[(u8, u8, u8)], min_area: usize) -> usize {
+    let (w, h) = (win.width(), win.height());
+    let mut class = vec![0u8; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let v = img.at(win.x0 + x, win.y0 + y);
+            class[y * w + x] = ranges.iter().find(|r| (r.0..=r.1).contains(&v)).map_or(0, |r| r.2);
+        }
+    }
+    let mut parent: Vec<usize> = (0..w * h).collect();
+    fn root(p: &mut [usize], mut i: usize) -> usize {
+        while p[i] != i {
+            p[i] = p[p[i]];
+            i = p[i];
+        }
+        i
+    }
+    for y in 0..h {
+        for x in 0..w {
+            let c = class[y * w + x];
+            if c == 0 {
+                continue;
+            }
+            for (dx, dy) in [(-1isize, 0isize), (-1, -1), (0, -1), (1, -1)] {
+                let (nx, ny) = (x as isize + dx, y as isize + dy);
+                if nx >= 0 && ny >= 0 && (nx as usize) < w && class[ny as usize * w + nx as usize] == c {
+                    let (a, b) =
+                        (root(&mut parent, y * w + x), root(&mut parent, ny as usize * w + nx as usize));
+                    parent[a.max(b)] = a.min(b);
+                }
+            }
+        }
+    }
+    let mut stats = std::collections::HashMap::<usize, [f64; 5]>::new();
+    for y in 0..h {
+        for x in 0..w {
+            if class[y * w + x] != 0 {
+                let v = f64::from(img.at(win.x0 + x, win.y0 + y));
+                let s = stats.entry(root(&mut parent, y * w + x)).or_default();
+                for (k, a) in [1.0, x as f64, y as f64, v, v * v].into_iter().enumerate() {
+                    s[k] += a;
+                }
+            }
+        }
+    }
+    stats.values().filter(|s| s[0] >= min_area as f64).count()
+}

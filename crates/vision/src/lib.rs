@@ -3,6 +3,7 @@
 //! on camera frames in shared memory, inside the windows it is asked to look in.
 
 pub mod flf;
+pub mod frs;
 pub mod image;
 pub mod moravec;
 pub mod nc;

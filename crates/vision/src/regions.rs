@@ -127,7 +127,14 @@ impl Runs {
             m.y_min = m.y_min.min(y as f32);
             m.y_max = m.y_max.max(y as f32);
             let row = r.y as usize;
-            m.value += (r.x0 as usize..r.x1 as usize).map(|x| f64::from(value(x, row))).sum::<f64>();
+            let (mut v, mut vv) = (0.0f64, 0.0f64);
+            for x in r.x0 as usize..r.x1 as usize {
+                let p = f64::from(value(x, row));
+                v += p;
+                vv += p * p;
+            }
+            m.value += v;
+            m.value_sq += vv;
         }
     }
 
@@ -165,8 +172,9 @@ pub struct Moments {
     pub sxx: f64,
     pub sxy: f64,
     pub syy: f64,
-    /// Sum of the per-pixel value (gradient magnitude, intensity).
+    /// Sum of the per-pixel value (gradient magnitude, intensity), and of its square.
     pub value: f64,
+    pub value_sq: f64,
     pub class: u8,
     pub x_min: f32,
     pub x_max: f32,
@@ -184,6 +192,7 @@ impl Default for Moments {
             sxy: 0.0,
             syy: 0.0,
             value: 0.0,
+            value_sq: 0.0,
             class: 0,
             x_min: f32::MAX,
             x_max: f32::MIN,
