@@ -42,10 +42,10 @@ pub struct Corner {
 #[derive(Debug, Default)]
 pub struct Moravec {
     interest: Vec<u32>,
-    cols: Vec<u32>,
-    row: Vec<u32>,
+    bufs: Buffers,
     row_max: Vec<u32>,
     max: Vec<u32>,
+    peak: Vec<u8>,
     corners: Vec<Corner>,
     width: usize,
 }
@@ -86,17 +86,13 @@ impl Moravec {
         if ww <= 2 * m || wh <= 2 * m {
             return Ok(&self.interest);
         }
-        self.cols.clear();
-        self.cols.resize(SHIFTS.len() * ww, 0);
-        self.row.clear();
-        self.row.resize(ww, 0);
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2.
-            unsafe { interest_avx2(img, w, p.window, &mut self.cols, &mut self.row, &mut self.interest) };
+            unsafe { interest_avx2(img, w, p.window, &mut self.bufs, &mut self.interest) };
             return Ok(&self.interest);
         }
-        interest(img, w, p.window, &mut self.cols, &mut self.row, &mut self.interest);
+        interest(img, w, p.window, &mut self.bufs, &mut self.interest);
         Ok(&self.interest)
     }
 
@@ -119,13 +115,24 @@ impl Moravec {
         #[cfg(not(target_arch = "x86_64"))]
         dilate(&self.interest, &mut self.row_max, &mut self.max, ww, wh, r);
         let threshold = p.threshold.max(1);
+        self.peak.clear();
+        self.peak.resize(ww, 0);
         for y in 0..wh {
             let (vals, maxs) = (&self.interest[y * ww..(y + 1) * ww], &self.max[y * ww..(y + 1) * ww]);
-            for x in 0..ww {
-                let v = vals[x];
-                if v < threshold || v != maxs[x] {
+            for ((k, &v), &mx) in self.peak.iter_mut().zip(vals).zip(maxs) {
+                *k = u8::from(v >= threshold && v == mx);
+            }
+            let mut x = 0;
+            while x < ww {
+                if x + 8 <= ww && self.peak[x..x + 8].iter().all(|&k| k == 0) {
+                    x += 8;
                     continue;
                 }
+                x += 1;
+                if self.peak[x - 1] == 0 {
+                    continue;
+                }
+                let (x, v) = (x - 1, vals[x - 1]);
                 // On a plateau, only the first pixel in scan order within the radius counts.
                 let before = |i: usize, j: usize| (j, i) < (y, x) && self.interest[j * ww + i] == v;
                 let twin = (y.saturating_sub(r)..=y)
@@ -135,8 +142,12 @@ impl Moravec {
                 }
             }
         }
-        self.corners.sort_by(|a, b| b.interest.cmp(&a.interest).then((a.y, a.x).cmp(&(b.y, b.x))));
+        let order = |a: &Corner, b: &Corner| b.interest.cmp(&a.interest).then((a.y, a.x).cmp(&(b.y, b.x)));
+        if self.corners.len() > p.max_corners && p.max_corners > 0 {
+            self.corners.select_nth_unstable_by(p.max_corners - 1, order);
+        }
         self.corners.truncate(p.max_corners);
+        self.corners.sort_by(order);
     }
 }
 
@@ -153,18 +164,47 @@ fn dilate(v: &[u32], row_max: &mut [u32], max: &mut [u32], ww: usize, wh: usize,
     dilate_cols(row_max, max, ww, wh, r);
 }
 
+/// `out[x] = max(taps[0][x], …, taps[K - 1][x])` in one pass.
+#[inline(always)]
+fn max_of<const K: usize>(taps: [&[u32]; K], out: &mut [u32]) {
+    for (x, o) in out.iter_mut().enumerate() {
+        let mut m = 0u32;
+        for t in &taps {
+            m = m.max(t[x]);
+        }
+        *o = m;
+    }
+}
+
+/// `out[i] = max(taps(j)[i] for j in 0 .. 2r + 1)` for the common radii in one pass each,
+/// else tap by tap.
+#[inline(always)]
+fn max_taps<'a>(r: usize, taps: impl Fn(usize) -> &'a [u32], out: &mut [u32]) {
+    match r {
+        1 => max_of::<3>(std::array::from_fn(&taps), out),
+        2 => max_of::<5>(std::array::from_fn(&taps), out),
+        3 => max_of::<7>(std::array::from_fn(&taps), out),
+        4 => max_of::<9>(std::array::from_fn(&taps), out),
+        _ => {
+            out.copy_from_slice(&taps(0)[..out.len()]);
+            for j in 1..=2 * r {
+                for (o, &a) in out.iter_mut().zip(taps(j)) {
+                    *o = (*o).max(a);
+                }
+            }
+        }
+    }
+}
+
 /// `out[x] = max(v[x - r ..= x + r])` along each row.
 #[inline(always)]
 fn dilate_rows(v: &[u32], out: &mut [u32], ww: usize, r: usize) {
     for (src, dst) in v.chunks_exact(ww).zip(out.chunks_exact_mut(ww)) {
-        dst.copy_from_slice(src);
-        for s in 1..=r.min(ww - 1) {
-            for (o, &a) in dst[..ww - s].iter_mut().zip(&src[s..]) {
-                *o = (*o).max(a);
-            }
-            for (o, &a) in dst[s..].iter_mut().zip(&src[..ww - s]) {
-                *o = (*o).max(a);
-            }
+        if ww > 2 * r {
+            max_taps(r, |j| &src[j..j + ww - 2 * r], &mut dst[r..ww - r]);
+        }
+        for x in (0..r.min(ww)).chain(ww.saturating_sub(r).max(r.min(ww))..ww) {
+            dst[x] = src[x.saturating_sub(r)..(x + r + 1).min(ww)].iter().copied().max().unwrap_or(0);
         }
     }
 }
@@ -174,6 +214,11 @@ fn dilate_rows(v: &[u32], out: &mut [u32], ww: usize, r: usize) {
 fn dilate_cols(v: &[u32], out: &mut [u32], ww: usize, wh: usize, r: usize) {
     for y in 0..wh {
         let dst = &mut out[y * ww..(y + 1) * ww];
+        if y >= r && y + r < wh {
+            max_taps(r, |j| &v[(y - r + j) * ww..(y - r + j + 1) * ww], dst);
+            continue;
+        }
+        dst.fill(0);
         for j in y.saturating_sub(r)..(y + r + 1).min(wh) {
             for (o, &s) in dst.iter_mut().zip(&v[j * ww..(j + 1) * ww]) {
                 *o = (*o).max(s);
@@ -184,15 +229,8 @@ fn dilate_cols(v: &[u32], out: &mut [u32], ww: usize, wh: usize, r: usize) {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn interest_avx2(
-    img: &Gray<'_>,
-    w: Rect,
-    k: usize,
-    cols: &mut [u32],
-    row: &mut [u32],
-    out: &mut [u32],
-) {
-    interest(img, w, k, cols, row, out)
+unsafe fn interest_avx2(img: &Gray<'_>, w: Rect, k: usize, bufs: &mut Buffers, out: &mut [u32]) {
+    interest(img, w, k, bufs, out)
 }
 
 /// The squared differences of image row `y` with itself shifted by `(dx, dy)`, columns
@@ -210,63 +248,116 @@ fn shifted<'a>(
     (a, b)
 }
 
+/// `(p - q)²`: at most 255², which fits 16 bits, so it is formed in 16-bit lanes.
 #[inline(always)]
 fn sq(p: u8, q: u8) -> u32 {
-    let d = i32::from(p) - i32::from(q);
-    (d * d) as u32
+    let d = i16::from(p) - i16::from(q);
+    u32::from(d.wrapping_mul(d) as u16)
 }
 
-/// Window sums of `k` consecutive column sums, folded into `dst` by minimum (or stored, for
-/// the first shift): whole-row passes over shifted slices, which vectorise.
+/// The `k`-wide horizontal sums of one image row's squared differences for one shift:
+/// `out[x] = Σ_j D(x + j)`, with `d` as scratch for the differences.
 #[inline(always)]
-fn fold_min(cols: &[u32], k: usize, sum: &mut [u32], dst: &mut [u32], first: bool) {
-    let n = dst.len();
-    let sum = &mut sum[..n];
-    sum.copy_from_slice(&cols[..n]);
-    for j in 1..k {
-        for (a, &b) in sum.iter_mut().zip(&cols[j..j + n]) {
-            *a += b;
-        }
+fn row_sums(
+    img: &Gray<'_>,
+    y: usize,
+    x0: usize,
+    shift: (isize, isize),
+    k: usize,
+    d: &mut [u32],
+    out: &mut [u32],
+) {
+    let (a, b) = shifted(img, y, x0, d.len(), shift);
+    for ((o, &p), &q) in d.iter_mut().zip(a).zip(b) {
+        *o = sq(p, q);
     }
-    if first {
-        dst.copy_from_slice(sum);
-    } else {
-        for (o, &v) in dst.iter_mut().zip(sum.iter()) {
-            *o = (*o).min(v);
+    let m = out.len();
+    match k {
+        3 => window_sum::<3>(d, out),
+        5 => window_sum::<5>(d, out),
+        7 => window_sum::<7>(d, out),
+        _ => {
+            out.copy_from_slice(&d[..m]);
+            for j in 1..k {
+                for (o, &v) in out.iter_mut().zip(&d[j..j + m]) {
+                    *o += v;
+                }
+            }
         }
     }
 }
 
+/// `out[x] = d[x] + … + d[x + K - 1]` in one pass (K shifted slices, which vectorises).
 #[inline(always)]
-fn interest(img: &Gray<'_>, w: Rect, k: usize, cols: &mut [u32], row: &mut [u32], out: &mut [u32]) {
+fn window_sum<const K: usize>(d: &[u32], out: &mut [u32]) {
+    let m = out.len();
+    let taps: [&[u32]; K] = std::array::from_fn(|j| &d[j..j + m]);
+    for (x, o) in out.iter_mut().enumerate() {
+        let mut s = 0u32;
+        for t in &taps {
+            s += t[x];
+        }
+        *o = s;
+    }
+}
+
+/// Interest of every centre of `w`: per shift, each row's horizontal window sums are made once
+/// (kept in a ring of `k + 1` rows), and a column sum per centre adds the row entering the
+/// window and takes the row leaving it.
+#[inline(always)]
+fn interest(img: &Gray<'_>, w: Rect, k: usize, bufs: &mut Buffers, out: &mut [u32]) {
     let (ww, wh, h) = (w.width(), w.height(), k / 2);
     // Columns whose shifted pixels stay in the window: 1 .. ww - 1 (the left and right shifts).
     let (cx0, n) = (1, ww - 2);
+    let m = n - 2 * h;
     let top = 1; // first window row (row 0 is needed by the up-right shift)
+    let slots = k + 1;
+    bufs.ring.clear();
+    bufs.ring.resize(SHIFTS.len() * slots * m, 0);
+    bufs.cols.clear();
+    bufs.cols.resize(SHIFTS.len() * m, 0);
+    bufs.diffs.clear();
+    bufs.diffs.resize(n, 0);
+    let Buffers { ring, cols, diffs } = bufs;
+    let slot = |d: usize, r: usize| (d * slots + r % slots) * m;
     for (d, &shift) in SHIFTS.iter().enumerate() {
-        let c = &mut cols[d * ww..d * ww + n];
         for r in top..top + k {
-            let (a, b) = shifted(img, w.y0 + r, w.x0 + cx0, n, shift);
-            for ((c, &p), &q) in c.iter_mut().zip(a).zip(b) {
-                *c += sq(p, q);
+            let at = slot(d, r);
+            row_sums(img, w.y0 + r, w.x0 + cx0, shift, k, diffs, &mut ring[at..at + m]);
+            for (c, &v) in cols[d * m..(d + 1) * m].iter_mut().zip(&ring[at..at + m]) {
+                *c += v;
             }
         }
     }
     // Output row `y` is the window's centre row: rows `y - h ..= y + h`.
     for y in top + h..wh - 1 - h {
-        let dst = &mut out[y * ww + cx0 + h..y * ww + cx0 + n - h];
+        let dst = &mut out[y * ww + cx0 + h..y * ww + cx0 + h + m];
         for (d, &shift) in SHIFTS.iter().enumerate() {
-            let c = &mut cols[d * ww..d * ww + n];
+            let c = &mut cols[d * m..(d + 1) * m];
             if y > top + h {
-                let (a, b) = shifted(img, w.y0 + y + h, w.x0 + cx0, n, shift);
-                let (e, f) = shifted(img, w.y0 + y - h - 1, w.x0 + cx0, n, shift);
-                for ((((c, &p), &q), &r), &s) in c.iter_mut().zip(a).zip(b).zip(e).zip(f) {
-                    *c = c.wrapping_add(sq(p, q)).wrapping_sub(sq(r, s));
+                let (enter, leave) = (slot(d, y + h), slot(d, y - h - 1));
+                row_sums(img, w.y0 + y + h, w.x0 + cx0, shift, k, diffs, &mut ring[enter..enter + m]);
+                let (new, old) = (&ring[enter..enter + m], &ring[leave..leave + m]);
+                for ((c, &a), &b) in c.iter_mut().zip(new).zip(old) {
+                    *c = c.wrapping_add(a).wrapping_sub(b);
                 }
             }
-            fold_min(c, k, row, dst, d == 0);
+        }
+        let (c0, rest) = cols.split_at(m);
+        let (c1, rest) = rest.split_at(m);
+        let (c2, c3) = rest.split_at(m);
+        for ((((o, &a), &b), &c), &e) in dst.iter_mut().zip(c0).zip(c1).zip(c2).zip(c3) {
+            *o = a.min(b).min(c).min(e);
         }
     }
+}
+
+/// Scratch of [`interest`].
+#[derive(Debug, Default)]
+struct Buffers {
+    ring: Vec<u32>,
+    cols: Vec<u32>,
+    diffs: Vec<u32>,
 }
 
 #[cfg(test)]
@@ -335,6 +426,41 @@ mod tests {
                 "no corner near ({cx}, {cy}): {found:?}"
             );
         }
+    }
+
+    #[test]
+    fn corners_are_exactly_the_strict_local_maxima() {
+        let img = GrayBuf::from_fn(90, 70, |x, y| ((x * 37 + y * 91 + x * y * 13) % 251) as u8);
+        let p = MoravecParams { window: 5, threshold: 50_000, suppress_radius: 3, max_corners: 100_000 };
+        let mut m = Moravec::default();
+        let map = m.interest_map(&img.view(), img.view().full(), &p).expect("runs").to_vec();
+        let at = |x: usize, y: usize| map[y * 90 + x];
+        let mut want = Vec::new();
+        for y in 0..70 {
+            for x in 0..90 {
+                let v = at(x, y);
+                let r = 3usize;
+                let nbrs = (y.saturating_sub(r)..=(y + r).min(69))
+                    .flat_map(|j| (x.saturating_sub(r)..=(x + r).min(89)).map(move |i| (i, j)));
+                let peak = nbrs.clone().all(|(i, j)| at(i, j) <= v)
+                    && !nbrs.filter(|&(i, j)| (j, i) < (y, x)).any(|(i, j)| at(i, j) == v);
+                if v >= p.threshold && peak {
+                    want.push((x, y));
+                }
+            }
+        }
+        let mut got: Vec<(usize, usize)> =
+            m.corners(&img.view(), img.view().full(), &p).expect("runs").iter().map(|c| (c.x, c.y)).collect();
+        got.sort_by_key(|&(x, y)| (y, x));
+        assert!(want.len() > 20, "a textured image has many corners: {}", want.len());
+        assert_eq!(got, want);
+        // The strongest come first, and the cap keeps the strongest.
+        let capped =
+            m.corners(&img.view(), img.view().full(), &MoravecParams { max_corners: 5, ..p }).expect("runs");
+        let top: Vec<u32> = capped.iter().map(|c| c.interest).collect();
+        let mut all: Vec<u32> = want.iter().map(|&(x, y)| at(x, y)).collect();
+        all.sort_unstable_by(|a, b| b.cmp(a));
+        assert_eq!(top, all[..5]);
     }
 
     #[test]
