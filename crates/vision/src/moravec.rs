@@ -43,9 +43,6 @@ pub struct Corner {
 pub struct Moravec {
     interest: Vec<u32>,
     bufs: Buffers,
-    row_max: Vec<u32>,
-    max: Vec<u32>,
-    peak: Vec<u8>,
     corners: Vec<Corner>,
     width: usize,
 }
@@ -79,12 +76,21 @@ impl Moravec {
         }
         let (ww, wh) = (w.width(), w.height());
         self.width = ww;
-        self.interest.clear();
-        self.interest.resize(ww * wh, 0);
         // Centres whose window and shifted window stay inside: a margin of half + 1.
         let m = p.window / 2 + 1;
         if ww <= 2 * m || wh <= 2 * m {
+            self.interest.clear();
+            self.interest.resize(ww * wh, 0);
             return Ok(&self.interest);
+        }
+        // Every centre is written below; only the margins need zeros.
+        self.interest.resize(ww * wh, 0);
+        let (top, bottom) = (m, wh - m);
+        self.interest[..top * ww].fill(0);
+        self.interest[bottom * ww..].fill(0);
+        for row in self.interest[top * ww..bottom * ww].chunks_exact_mut(ww) {
+            row[..m].fill(0);
+            row[ww - m..].fill(0);
         }
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
@@ -96,49 +102,42 @@ impl Moravec {
         Ok(&self.interest)
     }
 
-    /// Local maxima: a pixel at or above the threshold that equals the largest interest within
-    /// `suppress_radius` (a separable maximum filter); of equal neighbours only the first counts.
+    /// Local maxima: a pixel at or above the threshold with no larger interest within
+    /// `suppress_radius` (a square), and, on a plateau, the first in scan order. Most pixels
+    /// fall below the threshold, so candidates are found a block at a time and only they are
+    /// compared with their neighbours.
     fn suppress(&mut self, w: Rect, p: &MoravecParams) {
         self.corners.clear();
         let (ww, wh, r) = (self.width, w.height(), p.suppress_radius);
-        for v in [&mut self.row_max, &mut self.max] {
-            v.clear();
-            v.resize(self.interest.len(), 0);
-        }
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2.
-            unsafe { dilate_avx2(&self.interest, &mut self.row_max, &mut self.max, ww, wh, r) };
-        } else {
-            dilate(&self.interest, &mut self.row_max, &mut self.max, ww, wh, r);
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        dilate(&self.interest, &mut self.row_max, &mut self.max, ww, wh, r);
         let threshold = p.threshold.max(1);
-        self.peak.clear();
-        self.peak.resize(ww, 0);
+        let map = &self.interest;
         for y in 0..wh {
-            let (vals, maxs) = (&self.interest[y * ww..(y + 1) * ww], &self.max[y * ww..(y + 1) * ww]);
-            for ((k, &v), &mx) in self.peak.iter_mut().zip(vals).zip(maxs) {
-                *k = u8::from(v >= threshold && v == mx);
-            }
-            let mut x = 0;
-            while x < ww {
-                if x + 8 <= ww && self.peak[x..x + 8].iter().all(|&k| k == 0) {
-                    x += 8;
+            let row = &map[y * ww..(y + 1) * ww];
+            let (ys, ye) = (y.saturating_sub(r), (y + r).min(wh - 1));
+            for (b, block) in row.chunks(16).enumerate() {
+                if block.iter().fold(0, |m, &v| m.max(v)) < threshold {
                     continue;
                 }
-                x += 1;
-                if self.peak[x - 1] == 0 {
-                    continue;
-                }
-                let (x, v) = (x - 1, vals[x - 1]);
-                // On a plateau, only the first pixel in scan order within the radius counts.
-                let before = |i: usize, j: usize| (j, i) < (y, x) && self.interest[j * ww + i] == v;
-                let twin = (y.saturating_sub(r)..=y)
-                    .any(|j| (x.saturating_sub(r)..(x + r + 1).min(ww)).any(|i| before(i, j)));
-                if !twin {
-                    self.corners.push(Corner { x: w.x0 + x, y: w.y0 + y, interest: v });
+                for (i, &v) in block.iter().enumerate() {
+                    let x = b * 16 + i;
+                    if v < threshold {
+                        continue;
+                    }
+                    let (xs, xe) = (x.saturating_sub(r), (x + r).min(ww - 1));
+                    let peak = (ys..=ye).all(|j| {
+                        let nb = &map[j * ww + xs..=j * ww + xe];
+                        match j.cmp(&y) {
+                            std::cmp::Ordering::Less => nb.iter().all(|&u| u < v),
+                            std::cmp::Ordering::Greater => nb.iter().all(|&u| u <= v),
+                            std::cmp::Ordering::Equal => {
+                                nb[..x - xs].iter().all(|&u| u < v)
+                                    && nb[x - xs + 1..].iter().all(|&u| u <= v)
+                            }
+                        }
+                    });
+                    if peak {
+                        self.corners.push(Corner { x: w.x0 + x, y: w.y0 + y, interest: v });
+                    }
                 }
             }
         }
@@ -148,82 +147,6 @@ impl Moravec {
         }
         self.corners.truncate(p.max_corners);
         self.corners.sort_by(order);
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn dilate_avx2(v: &[u32], row_max: &mut [u32], max: &mut [u32], ww: usize, wh: usize, r: usize) {
-    dilate(v, row_max, max, ww, wh, r)
-}
-
-/// The largest value within `r` pixels (a square), by rows then columns.
-#[inline(always)]
-fn dilate(v: &[u32], row_max: &mut [u32], max: &mut [u32], ww: usize, wh: usize, r: usize) {
-    dilate_rows(v, row_max, ww, r);
-    dilate_cols(row_max, max, ww, wh, r);
-}
-
-/// `out[x] = max(taps[0][x], …, taps[K - 1][x])` in one pass.
-#[inline(always)]
-fn max_of<const K: usize>(taps: [&[u32]; K], out: &mut [u32]) {
-    for (x, o) in out.iter_mut().enumerate() {
-        let mut m = 0u32;
-        for t in &taps {
-            m = m.max(t[x]);
-        }
-        *o = m;
-    }
-}
-
-/// `out[i] = max(taps(j)[i] for j in 0 .. 2r + 1)` for the common radii in one pass each,
-/// else tap by tap.
-#[inline(always)]
-fn max_taps<'a>(r: usize, taps: impl Fn(usize) -> &'a [u32], out: &mut [u32]) {
-    match r {
-        1 => max_of::<3>(std::array::from_fn(&taps), out),
-        2 => max_of::<5>(std::array::from_fn(&taps), out),
-        3 => max_of::<7>(std::array::from_fn(&taps), out),
-        4 => max_of::<9>(std::array::from_fn(&taps), out),
-        _ => {
-            out.copy_from_slice(&taps(0)[..out.len()]);
-            for j in 1..=2 * r {
-                for (o, &a) in out.iter_mut().zip(taps(j)) {
-                    *o = (*o).max(a);
-                }
-            }
-        }
-    }
-}
-
-/// `out[x] = max(v[x - r ..= x + r])` along each row.
-#[inline(always)]
-fn dilate_rows(v: &[u32], out: &mut [u32], ww: usize, r: usize) {
-    for (src, dst) in v.chunks_exact(ww).zip(out.chunks_exact_mut(ww)) {
-        if ww > 2 * r {
-            max_taps(r, |j| &src[j..j + ww - 2 * r], &mut dst[r..ww - r]);
-        }
-        for x in (0..r.min(ww)).chain(ww.saturating_sub(r).max(r.min(ww))..ww) {
-            dst[x] = src[x.saturating_sub(r)..(x + r + 1).min(ww)].iter().copied().max().unwrap_or(0);
-        }
-    }
-}
-
-/// `out[y] = max(v[y - r ..= y + r])` down each column.
-#[inline(always)]
-fn dilate_cols(v: &[u32], out: &mut [u32], ww: usize, wh: usize, r: usize) {
-    for y in 0..wh {
-        let dst = &mut out[y * ww..(y + 1) * ww];
-        if y >= r && y + r < wh {
-            max_taps(r, |j| &v[(y - r + j) * ww..(y - r + j + 1) * ww], dst);
-            continue;
-        }
-        dst.fill(0);
-        for j in y.saturating_sub(r)..(y + r + 1).min(wh) {
-            for (o, &s) in dst.iter_mut().zip(&v[j * ww..(j + 1) * ww]) {
-                *o = (*o).max(s);
-            }
-        }
     }
 }
 
