@@ -40,6 +40,9 @@ struct Row {
     kernel: &'static str,
     size: String,
     scope: String,
+    /// The window worked in, and (correlation) where the template was cut.
+    window: Rect,
+    template: Rect,
     harvey_us: f64,
     reference_us: f64,
 }
@@ -111,6 +114,8 @@ fn bench_nc(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
             kernel: "normalised correlation 16x16",
             size: size.to_owned(),
             scope,
+            window: win,
+            template: tr,
             harvey_us,
             reference_us,
         });
@@ -130,7 +135,15 @@ fn bench_moravec(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
         let reference_us = time(|| {
             black_box(reference::moravec(img, win, p.window, p.threshold, p.suppress_radius));
         });
-        rows.push(Row { kernel: "Moravec 5x5", size: size.to_owned(), scope, harvey_us, reference_us });
+        rows.push(Row {
+            kernel: "Moravec 5x5",
+            size: size.to_owned(),
+            scope,
+            window: win,
+            template: Rect::default(),
+            harvey_us,
+            reference_us,
+        });
     }
 }
 
@@ -146,7 +159,15 @@ fn bench_flf(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
         let reference_us = time(|| {
             black_box(reference::flf(img, win, p.buckets, p.min_gradient, f64::from(p.min_length)));
         });
-        rows.push(Row { kernel: "fast line finder", size: size.to_owned(), scope, harvey_us, reference_us });
+        rows.push(Row {
+            kernel: "fast line finder",
+            size: size.to_owned(),
+            scope,
+            window: win,
+            template: Rect::default(),
+            harvey_us,
+            reference_us,
+        });
     }
 }
 
@@ -173,6 +194,8 @@ fn bench_frs(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
             kernel: "fast region segmenter + stats",
             size: size.to_owned(),
             scope,
+            window: win,
+            template: Rect::default(),
             harvey_us,
             reference_us,
         });
@@ -196,7 +219,7 @@ fn main() {
     }
     println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
     println!("|---|---|---|---:|---:|---:|");
-    let mut tsv = String::from("kernel\tsize\tscope\tharvey_us\treference_us\n");
+    let mut tsv = String::from("kernel\tsize\tscope\twindow\ttemplate\tharvey_us\treference_us\n");
     for r in &rows {
         println!(
             "| {} | {} | {} | {:.1} | {:.1} | {:.1}x |",
@@ -207,7 +230,17 @@ fn main() {
             r.reference_us,
             r.reference_us / r.harvey_us
         );
-        tsv += &format!("{}\t{}\t{}\t{:.3}\t{:.3}\n", r.kernel, r.size, r.scope, r.harvey_us, r.reference_us);
+        let rect = |r: Rect| format!("{},{},{},{}", r.x0, r.y0, r.x1, r.y1);
+        tsv += &format!(
+            "{}\t{}\t{}\t{}\t{}\t{:.3}\t{:.3}\n",
+            r.kernel,
+            r.size,
+            r.scope,
+            rect(r.window),
+            rect(r.template),
+            r.harvey_us,
+            r.reference_us
+        );
     }
     std::fs::write(out.join("harvey.tsv"), tsv).expect("writes the figures");
 }

@@ -1,0 +1,101 @@
+"""Times OpenCV on the frames and windows `cargo bench -p harvey-vision --bench kernels` used,
+single thread, and writes the Harvey / OpenCV table into docs/benchmarks.md.
+
+OpenCV has no Moravec operator, no Burns line finder and no reflectance-normalised correlation;
+each row names the nearest OpenCV routine timed in its place: TM_CCORR_NORMED template matching,
+cornerMinEigenVal with the same 5x5 block plus a dilate-based local-maximum test, the LSD line
+segment detector, and LUT + connectedComponentsWithStats per class.
+"""
+
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+BENCH = ROOT / "target" / "vision-bench"
+DOC = ROOT / "docs" / "benchmarks.md"
+START, END = "<!-- vision-opencv:start -->", "<!-- vision-opencv:end -->"
+
+
+def timed(f, budget=0.3):
+    f()
+    t0 = time.perf_counter()
+    f()
+    once = max(time.perf_counter() - t0, 1e-7)
+    reps = int(min(max(budget / once, 5), 20000))
+    samples = []
+    for _ in range(reps):
+        t = time.perf_counter()
+        f()
+        samples.append((time.perf_counter() - t) * 1e6)
+    return statistics.median(samples)
+
+
+def rect(text):
+    x0, y0, x1, y1 = (int(v) for v in text.split(","))
+    return x0, y0, x1, y1
+
+
+def opencv_case(kernel, img, win, tmpl):
+    x0, y0, x1, y1 = win
+    sub = np.ascontiguousarray(img[y0:y1, x0:x1])
+    if kernel.startswith("normalised correlation"):
+        tx0, ty0, tx1, ty1 = tmpl
+        t = np.ascontiguousarray(img[ty0:ty1, tx0:tx1])
+        return "matchTemplate TM_CCORR_NORMED + minMaxLoc", lambda: cv2.minMaxLoc(
+            cv2.matchTemplate(sub, t, cv2.TM_CCORR_NORMED))
+    if kernel.startswith("Moravec"):
+        kernel7 = np.ones((7, 7), np.uint8)
+
+        def corners():
+            e = cv2.cornerMinEigenVal(sub, 5)
+            peaks = (e == cv2.dilate(e, kernel7)) & (e > 1e-3)
+            return np.count_nonzero(peaks)
+        return "cornerMinEigenVal 5x5 + dilate maxima", corners
+    if kernel.startswith("fast line finder"):
+        lsd = cv2.createLineSegmentDetector()
+        return "LSD line segment detector", lambda: lsd.detect(sub)
+    if kernel.startswith("fast region segmenter"):
+        lut = np.zeros(256, np.uint8)
+        lut[0:71], lut[71:171], lut[171:256] = 1, 2, 3
+
+        def regions():
+            classes = cv2.LUT(sub, lut)
+            return [cv2.connectedComponentsWithStats((classes == c).astype(np.uint8), connectivity=8)
+                    for c in (1, 2, 3)]
+        return "LUT + connectedComponentsWithStats per class", regions
+    raise ValueError(kernel)
+
+
+def main():
+    cv2.setNumThreads(1)
+    rows = [l.split("\t") for l in (BENCH / "harvey.tsv").read_text().splitlines()[1:]]
+    frames = {}
+    lines = ["| kernel | image | scope | Harvey µs | OpenCV µs | OpenCV routine | OpenCV / Harvey |",
+             "|---|---|---|---:|---:|---|---:|"]
+    for kernel, size, scope, win, tmpl, harvey_us, _ref in rows:
+        img = frames.setdefault(size, cv2.imread(str(BENCH / f"frame_{size}.pgm"), cv2.IMREAD_GRAYSCALE))
+        if img is None:
+            sys.exit(f"cannot read {BENCH / f'frame_{size}.pgm'}: run the kernels bench first")
+        name, f = opencv_case(kernel, img, rect(win), rect(tmpl))
+        us = timed(f)
+        lines.append(f"| {kernel} | {size} | {scope} | {float(harvey_us):.1f} | {us:.1f} | {name} | "
+                     f"{us / float(harvey_us):.2f}x |")
+    table = "\n".join(lines)
+    print(table)
+    text = DOC.read_text()
+    block = f"{START}\nOpenCV {cv2.__version__}, `cv2.setNumThreads(1)`, same frames and windows:\n\n{table}\n{END}"
+    if START in text and END in text:
+        text = text[: text.index(START)] + block + text[text.index(END) + len(END):]
+    else:
+        text = text.rstrip("\n") + "\n\n" + block + "\n"
+    DOC.write_text(text)
+    print(f"written into {DOC.relative_to(ROOT)}")
+
+
+if __name__ == "__main__":
+    main()
