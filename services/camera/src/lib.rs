@@ -61,38 +61,16 @@ impl Renderer {
         }
         let cx = f64::from(self.width_px) / 2.0;
         for (u, col) in self.columns.iter_mut().enumerate() {
-            let off_axis = ((cx - u as f64 - 0.5) / self.focal_px).atan(); // left is positive
-            let a = heading + off_axis;
-            let dir = [a.cos(), a.sin()];
-            let cos_off_axis = off_axis.cos();
-            let wall =
-                world.cast_ray([x, y], dir, 1e3).map(|h| (h.distance_m * cos_off_axis, h.wall, h.along_m));
-            *col = Column { dir, cos_off_axis, wall };
+            *col = Column::cast(world, pose, (cx - u as f64 - 0.5) / self.focal_px);
         }
         let cam = &world.camera;
-        let floor = &world.floor;
         let cy = f64::from(self.height_px) / 2.0;
         let bpp = self.encoding.bytes_per_pixel() as usize;
         let row_bytes = self.width_px as usize * bpp;
         for (v, row) in out.chunks_exact_mut(row_bytes).enumerate() {
             let down = (v as f64 + 0.5 - cy) / self.focal_px; // image y of this row, down positive
             for (col, px) in self.columns.iter().zip(row.chunks_exact_mut(bpp)) {
-                const WHITE: [f64; 3] = [1.0; 3];
-                let (reflectance, colour) = match col.wall {
-                    Some((depth, wall, along)) => {
-                        let z = cam.height_m - down * depth;
-                        let w = &world.walls[wall];
-                        if (0.0..=w.height_m).contains(&z) {
-                            w.appearance_at(along, z)
-                        } else if z < 0.0 {
-                            (floor_at(world, [x, y], col, cam.height_m / down), WHITE)
-                        } else {
-                            (floor.ceiling_reflectance, WHITE)
-                        }
-                    }
-                    None if down > 0.0 => (floor_at(world, [x, y], col, cam.height_m / down), WHITE),
-                    None => (floor.ceiling_reflectance, WHITE),
-                };
+                let (reflectance, colour) = col.appearance(world, [x, y], down);
                 let lit = cam.illumination * reflectance;
                 if bpp == 1 {
                     px[0] = lit.round().clamp(0.0, 255.0) as u8;
@@ -105,6 +83,52 @@ impl Renderer {
         }
         Ok(())
     }
+}
+
+impl Column {
+    /// The ray of the image column whose direction is `tan_left` (left positive) off the axis.
+    fn cast(world: &World, pose: [f64; 3], tan_left: f64) -> Self {
+        let off_axis = tan_left.atan();
+        let a = pose[2] + off_axis;
+        let dir = [a.cos(), a.sin()];
+        let cos_off_axis = off_axis.cos();
+        let wall = world
+            .cast_ray([pose[0], pose[1]], dir, 1e3)
+            .map(|h| (h.distance_m * cos_off_axis, h.wall, h.along_m));
+        Column { dir, cos_off_axis, wall }
+    }
+
+    /// Reflectance and colour of what the ray `down` (image y over focal length) below the
+    /// axis in this column meets first.
+    fn appearance(&self, world: &World, origin: [f64; 2], down: f64) -> (f64, [f64; 3]) {
+        const WHITE: [f64; 3] = [1.0; 3];
+        let cam = &world.camera;
+        match self.wall {
+            Some((depth, wall, along)) => {
+                let z = cam.height_m - down * depth;
+                let w = &world.walls[wall];
+                if (0.0..=w.height_m).contains(&z) {
+                    w.appearance_at(along, z)
+                } else if z < 0.0 {
+                    (floor_at(world, origin, self, cam.height_m / down), WHITE)
+                } else {
+                    (world.floor.ceiling_reflectance, WHITE)
+                }
+            }
+            None if down > 0.0 => (floor_at(world, origin, self, cam.height_m / down), WHITE),
+            None => (world.floor.ceiling_reflectance, WHITE),
+        }
+    }
+}
+
+/// The reflectance a ray from the camera at `pose` meets first through image point `(u, v)`
+/// (pixels from the top-left corner) of a `width_px x height_px` image: ray tracing one pixel,
+/// as appearance templates are built (000 §5.3).
+pub fn reflectance_at(world: &World, pose: [f64; 3], width_px: u32, height_px: u32, u: f64, v: f64) -> f64 {
+    let f = world.camera.focal_for(width_px);
+    let (cx, cy) = (f64::from(width_px) / 2.0, f64::from(height_px) / 2.0);
+    let col = Column::cast(world, pose, (cx - u) / f);
+    col.appearance(world, [pose[0], pose[1]], (v - cy) / f).0
 }
 
 /// Reflectance of the floor tile seen at optical depth `depth_m` along a column.

@@ -5,6 +5,7 @@ use harvey_msgs::{Detections, Feature, FrameHeader, Header, MAX_FEATURES};
 
 /// Algorithm ids carried in [`Detections::algorithm`].
 pub mod landmarks;
+pub mod templates;
 
 pub const ALGO_VERTICAL_EDGES: u32 = 1;
 

@@ -1,0 +1,57 @@
+//! Appearance templates by ray tracing (000 §5.3): an `n x n` array centred on where a landmark
+//! point projects from the expected pose, each pixel `255 R` for the reflectance `R` of the first
+//! surface its ray meets. Matched by reflectance-normalised correlation (000 §5.4), a template
+//! needs no model of the lighting.
+
+use harvey_vision::{GrayBuf, Rect};
+use harvey_world::World;
+
+/// A template and where it sits in the image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AppearanceTemplate {
+    pub pixels: GrayBuf,
+    /// Top-left corner of the template in the image (pixels).
+    pub origin: [usize; 2],
+    /// Where the landmark point projects from the expected pose.
+    pub projection: [f64; 2],
+}
+
+impl AppearanceTemplate {
+    /// The template's own rectangle in the image.
+    pub fn rect(&self) -> Rect {
+        let [x, y] = self.origin;
+        Rect::new(x, y, x + self.pixels.width, y + self.pixels.height)
+    }
+}
+
+/// Builds the `side x side` template of world point `point_m` seen from `pose` in a
+/// `width x height` image; `None` when the point is behind the camera or the template would
+/// leave the image.
+pub fn build(
+    world: &World,
+    pose: [f64; 3],
+    point_m: [f64; 3],
+    width: u32,
+    height: u32,
+    side: usize,
+) -> Option<AppearanceTemplate> {
+    let [u, v] = world.camera.project(width, height, pose, point_m)?;
+    let half = side as f64 / 2.0;
+    let (x0, y0) = ((u - half).round(), (v - half).round());
+    if x0 < 0.0 || y0 < 0.0 || x0 + side as f64 > f64::from(width) || y0 + side as f64 > f64::from(height) {
+        return None;
+    }
+    let (x0, y0) = (x0 as usize, y0 as usize);
+    let pixels = GrayBuf::from_fn(side, side, |i, j| {
+        let r = harvey_camera::reflectance_at(
+            world,
+            pose,
+            width,
+            height,
+            (x0 + i) as f64 + 0.5,
+            (y0 + j) as f64 + 0.5,
+        );
+        (255.0 * r).round().clamp(0.0, 255.0) as u8
+    });
+    Some(AppearanceTemplate { pixels, origin: [x0, y0], projection: [u, v] })
+}
