@@ -3,7 +3,8 @@
 
 use harvey_msgs::{
     Detections, EncodersRaw, Expectation, Feature, FrameHeader, Header, LandmarkSighting, MissionStatus,
-    MotionCommand, Odometry, Pose2, SonarRaw, SonarRing, TruePose, UncertaintyMap,
+    MotionCommand, Odometry, Pose2, SonarRaw, SonarRing, TruePose, UncertaintyMap, VisionItem, VisionRequest,
+    VisionResult,
 };
 
 use crate::codec::{Cdr, CdrError, CdrReader, CdrWriter};
@@ -132,6 +133,9 @@ ros2_struct!(Detections, DETECTIONS = ("harvey_msgs/Detections", with_header!("u
 ros2_struct!(UncertaintyMap, UNCERTAINTY_MAP = ("harvey_msgs/UncertaintyMap", with_header!("harvey_msgs/Pose2 centre\nuint32 vertex_count\nuint32 lost\nfloat64[64] vertices_m # x0 y0 x1 y1 ...\nfloat64 heading_cw_rad\nfloat64 heading_ccw_rad\nfloat64 area_m2\nuint32 missed_landmarks\nuint32 reserved\n"), [&STD_HEADER, &POSE2]) { header, centre, vertex_count, lost, vertices_m, heading_cw_rad, heading_ccw_rad, area_m2, missed_landmarks, reserved });
 ros2_struct!(LandmarkSighting, LANDMARK_SIGHTING = ("harvey_msgs/LandmarkSighting", with_header!("uint64 frame_seq\nuint32 landmark_index\nuint32 kind # 0 not found, 1 bearing, 2 bearing+range, 3 ground line\nfloat64 a\nfloat64 a_sd\nfloat64 b\nfloat64 b_sd\n"), [&STD_HEADER]) { header, frame_seq, landmark_index, kind, a, a_sd, b, b_sd });
 ros2_struct!(Expectation, EXPECTATION = ("harvey_msgs/Expectation", with_header!("uint32 landmark_index\nuint32 class\nfloat32[4] window_px # u0 v0 u1 v1\nuint32 width_px\nuint32 height_px\n"), [&STD_HEADER]) { header, landmark_index, class, window_px, width_px, height_px });
+ros2_struct!(VisionItem, VISION_ITEM = ("harvey_msgs/VisionItem", "float32[6] values\n", []) { values });
+ros2_struct!(VisionRequest, VISION_REQUEST = ("harvey_msgs/VisionRequest", with_header!("uint32 request_id\nuint32 algorithm # 1 correlate, 2 moravec, 3 line finder, 4 region segmenter\nuint32 standing\nuint32 landmark_index\nharvey_msgs/Pose2 expected\nfloat32[4] window_px # u0 v0 u1 v1\nfloat32[8] params\n"), [&STD_HEADER, &POSE2]) { header, request_id, algorithm, standing, landmark_index, expected, window_px, params });
+ros2_struct!(VisionResult, VISION_RESULT = ("harvey_msgs/VisionResult", with_header!("uint64 frame_seq\nuint32 request_id\nuint32 algorithm\nuint32 status # 0 found, 1 not found, 2 window outside, 3 unknown landmark, 4 unknown algorithm, 5 bad parameter, 6 bad template, 7 bad frame\nuint32 found\nuint32 count\nuint32 reserved\nharvey_msgs/VisionItem[32] items\n"), [&STD_HEADER, &VISION_ITEM]) { header, frame_seq, request_id, algorithm, status, found, count, reserved, items });
 ros2_struct!(MissionStatus, MISSION_STATUS = ("harvey_msgs/MissionStatus", with_header!("uint32 state # 0 running, 1 succeeded, 2 failed\nuint32 step\nuint32 step_count\nuint32 reserved\nharvey_msgs/Pose2 estimated\nharvey_msgs/Pose2 goal\nuint64 sonar_rings_seen\nuint64 detections_seen\nuint64 maps_seen\n"), [&STD_HEADER, &POSE2]) { header, state, step, step_count, reserved, estimated, goal, sonar_rings_seen, detections_seen, maps_seen });
 
 impl Cdr for MotionCommand {
@@ -198,6 +202,26 @@ mod tests {
         let mut features = [Feature::default(); MAX_FEATURES];
         features[3] = Feature { x_px: 10.5, y_px: 4.0, score: 0.9, kind: 1 };
         round_trip(Detections { header: h, frame_seq: 7, count: 4, features, ..Default::default() });
+        let mut items = [VisionItem::default(); harvey_msgs::MAX_VISION_ITEMS];
+        items[31] = VisionItem { values: [1.0, -2.0, 3.5, 0.0, 5.0, 6.0] };
+        round_trip(VisionResult {
+            header: h,
+            frame_seq: 9,
+            request_id: 3,
+            status: 1,
+            count: 32,
+            items,
+            ..Default::default()
+        });
+        round_trip(VisionRequest {
+            header: h,
+            request_id: 4,
+            algorithm: 3,
+            expected: pose,
+            window_px: [1.0, 2.0, 3.0, 4.0],
+            params: [8.0, 0.0, 8.0, 10.0, f32::INFINITY, -1.0, 0.0, 0.5],
+            ..Default::default()
+        });
         round_trip(UncertaintyMap {
             header: h,
             centre: pose,

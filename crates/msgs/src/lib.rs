@@ -8,12 +8,14 @@
 mod frame;
 mod payloads;
 pub mod topics;
+mod vision;
 
 pub use frame::{Encoding, FrameHeader};
 pub use iceoryx2_bb_derive_macros::ZeroCopySend;
 pub use iceoryx2_bb_elementary_traits::zero_copy_send::ZeroCopySend;
 pub use payloads::*;
 pub use topics::{FrameTopic, Qos, Topic};
+pub use vision::*;
 
 /// The header every message starts with: a per-publisher sequence number and the time the
 /// message is about (simulated or sensor time, never the wall clock of the publisher).

@@ -20,6 +20,7 @@ macro_rules! message {
         }
     };
 }
+pub(crate) use message;
 
 /// A planar pose: position in metres and heading in radians (counter-clockwise from +x).
 #[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]

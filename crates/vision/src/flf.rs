@@ -141,7 +141,13 @@ impl Flf {
                 }
             }
         }
-        self.lines.sort_by(|a, b| b.length.total_cmp(&a.length));
+        // A total order (ties broken by position), unstable: sorting allocates nothing.
+        self.lines.sort_unstable_by(|a, b| {
+            b.length
+                .total_cmp(&a.length)
+                .then(a.from[1].total_cmp(&b.from[1]))
+                .then(a.from[0].total_cmp(&b.from[0]))
+        });
         Ok(&self.lines)
     }
 

@@ -91,7 +91,10 @@ impl Frs {
                 sd: (m.value_sq / m.n - mean * mean).max(0.0).sqrt() as f32,
             }
         }));
-        self.regions.sort_by(|a, b| b.area.cmp(&a.area).then(a.bbox.cmp(&b.bbox)));
+        // A total order (regions do not share a bounding box and class), unstable: no allocation.
+        self.regions.sort_unstable_by(|a, b| {
+            b.area.cmp(&a.area).then(a.bbox.cmp(&b.bbox)).then(a.class.cmp(&b.class))
+        });
         Ok(&self.regions)
     }
 }

@@ -28,6 +28,13 @@ pub struct Template {
 
 impl Template {
     pub fn new(t: &GrayBuf) -> Result<Self, VisionError> {
+        let mut out = Self { width: 0, height: 0, sum: 0.0, sum_sq: 0.0, packed: Vec::new(), groups: 0 };
+        out.set(t)?;
+        Ok(out)
+    }
+
+    /// Prepares `t` in place of the current template, reusing its memory.
+    pub fn set(&mut self, t: &GrayBuf) -> Result<(), VisionError> {
         let (w, h) = (t.width, t.height);
         if w == 0 || h == 0 || t.data.len() < w * h {
             return Err(VisionError::EmptyTemplate);
@@ -37,20 +44,22 @@ impl Template {
                 "template {w}x{h} over {MAX_TEMPLATE} pixels a side"
             )));
         }
-        let groups = w.div_ceil(4);
-        let mut packed = vec![0i32; groups * h];
-        for y in 0..h {
-            for x in 0..w {
-                let v = (i32::from(t.data[y * w + x]) - 128) as i8 as u8;
-                packed[y * groups + x / 4] |= i32::from(v) << (8 * (x % 4));
-            }
-        }
-        let sum = t.data.iter().map(|&v| f64::from(v)).sum();
-        let sum_sq = t.data.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
+        let sum: f64 = t.data.iter().map(|&v| f64::from(v)).sum();
         if sum == 0.0 {
             return Err(VisionError::BadParameter("an all-black template has no reflectance pattern".into()));
         }
-        Ok(Self { width: w, height: h, sum, sum_sq, packed, groups })
+        let groups = w.div_ceil(4);
+        self.packed.clear();
+        self.packed.resize(groups * h, 0);
+        for y in 0..h {
+            for x in 0..w {
+                let v = (i32::from(t.data[y * w + x]) - 128) as i8 as u8;
+                self.packed[y * groups + x / 4] |= i32::from(v) << (8 * (x % 4));
+            }
+        }
+        self.sum_sq = t.data.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
+        (self.width, self.height, self.sum, self.groups) = (w, h, sum, groups);
+        Ok(())
     }
 }
 

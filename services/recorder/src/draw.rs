@@ -3,7 +3,7 @@
 
 use harvey_msgs::{
     Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, SonarRaw,
-    SonarRing, TruePose, UncertaintyMap,
+    SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult,
 };
 
 use crate::RecordError;
@@ -34,7 +34,15 @@ draw_with!(
     MotionCommand => command,
     MissionStatus => status,
     Detections => detections,
+    VisionResult => vision_result,
 );
+
+/// Requests are in the MCAP file; the view shows their results.
+impl Draw for VisionRequest {
+    fn draw(&self, _: &mut RrdWriter) -> Result<(), RecordError> {
+        Ok(())
+    }
+}
 
 /// Raw DRV reports are in the MCAP file; the view shows their refined forms.
 impl Draw for SonarRaw {

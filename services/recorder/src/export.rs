@@ -6,7 +6,7 @@ use std::path::Path;
 use harvey_cdr::{Ros2Msg, decode, decode_image};
 use harvey_msgs::{
     Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, SonarRaw,
-    SonarRing, TruePose, UncertaintyMap, topics,
+    SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult, topics,
 };
 
 use crate::draw::Draw;
@@ -33,6 +33,8 @@ pub fn draw_recorded(w: &mut RrdWriter, topic: &str, data: &[u8]) -> Result<bool
         _ if t == topics::VISION_SIGHTINGS.name => draw::<LandmarkSighting>(w, data)?,
         _ if t == topics::UMS_EXPECTATIONS.name => draw::<Expectation>(w, data)?,
         _ if t == topics::EXECUTIVE_STATUS.name => draw::<MissionStatus>(w, data)?,
+        _ if t == topics::VISION_REQUESTS.name => draw::<VisionRequest>(w, data)?,
+        _ if t == topics::VISION_RESULTS.name => draw::<VisionResult>(w, data)?,
         _ if t == topics::CAMERA_FRAME.name => {
             let (h, pixels) = decode_image(data).map_err(|e| e.to_string())?;
             w.frame(&h, pixels).map_err(|e| e.to_string())?;

@@ -81,6 +81,8 @@ fn main() -> anyhow::Result<()> {
         tap(&bus, &mut rec, topics::VISION_SIGHTINGS)?,
         tap(&bus, &mut rec, topics::UMS_EXPECTATIONS)?,
         tap(&bus, &mut rec, topics::EXECUTIVE_STATUS)?,
+        tap(&bus, &mut rec, topics::VISION_REQUESTS)?,
+        tap(&bus, &mut rec, topics::VISION_RESULTS)?,
         Box::new(FrameTap { sub: bus.frame_subscriber(topics::CAMERA_FRAME)?, channel: frame_channel }),
     ];
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();

@@ -5,6 +5,7 @@
 //!
 //! The top-down view draws the world with y up: Rerun's 2D views put y down, so y is negated.
 
+mod vision;
 use std::path::Path;
 
 use harvey_msgs::{

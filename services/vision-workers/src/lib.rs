@@ -4,6 +4,7 @@
 use harvey_msgs::{Detections, Feature, FrameHeader, Header, MAX_FEATURES};
 
 /// Algorithm ids carried in [`Detections::algorithm`].
+pub mod dispatch;
 pub mod landmarks;
 pub mod templates;
 

@@ -7,8 +7,9 @@ use std::path::PathBuf;
 
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
-use harvey_msgs::{Expectation, topics};
+use harvey_msgs::{Expectation, VisionAlgorithm, VisionRequest, topics};
 use harvey_vision_workers::VerticalEdges;
+use harvey_vision_workers::dispatch::Dispatcher;
 use harvey_vision_workers::landmarks::LineLandmarks;
 
 #[derive(Parser)]
@@ -29,6 +30,23 @@ struct Args {
     /// Expectations older than this (message time) are not searched for.
     #[arg(long, default_value_t = 300)]
     expectation_max_age_ms: u64,
+    /// This worker's share of `vision/requests`, `K/N`: the requests whose id is K modulo N
+    /// (several workers share the load; any of them gives the same answer).
+    #[arg(long, default_value = "0/1")]
+    shard: String,
+    /// A standing request of this worker's own: the fast line finder on every frame, lines
+    /// between these orientations (degrees, `LO,HI`), published on `vision/requests` as id 1.
+    #[arg(long, value_delimiter = ',')]
+    lines: Option<Vec<f32>>,
+}
+
+/// `K/N` with `K < N`.
+fn shard(text: &str) -> anyhow::Result<(u32, u32)> {
+    let parsed = text.split_once('/').and_then(|(k, n)| Some((k.parse().ok()?, n.parse().ok()?)));
+    match parsed {
+        Some((k, n)) if k < n => Ok((k, n)),
+        _ => anyhow::bail!("--shard `{text}`: expected K/N with K < N, like 0/2"),
+    }
 }
 
 fn main() -> anyhow::Result<()> {
@@ -40,10 +58,31 @@ fn main() -> anyhow::Result<()> {
     let expectations = bus.subscriber(topics::UMS_EXPECTATIONS)?;
     let detections = bus.publisher(topics::VISION_DETECTIONS)?;
     let sightings = bus.publisher(topics::VISION_SIGHTINGS)?;
+    let requests = bus.subscriber(topics::VISION_REQUESTS)?;
+    let request_pub = bus.publisher(topics::VISION_REQUESTS)?;
+    let results = bus.publisher(topics::VISION_RESULTS)?;
+    let (k, n) = shard(&args.shard)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = pace.attach(&waiter, &[&frames, &expectations])?;
+    let _a = pace.attach(&waiter, &[&frames, &expectations, &requests])?;
     harvey_runtime::notify_ready()?;
+
+    // Requests by id (ascending, so answers come in a fixed order); one-shot ones go once answered.
+    let mut asked: BTreeMap<u32, VisionRequest> = BTreeMap::new();
+    if let Some(range) = &args.lines {
+        anyhow::ensure!(range.len() == 2, "--lines takes LO,HI in degrees; got {range:?}");
+        let mut own = VisionRequest {
+            request_id: 1,
+            algorithm: VisionAlgorithm::LineFinder as u32,
+            standing: 1,
+            ..Default::default()
+        };
+        own.params[4..6].copy_from_slice(range);
+        // Published so the recording shows what was asked; answered like any other.
+        request_pub.send(&own)?;
+        asked.insert(own.request_id, own);
+    }
+    let mut dispatcher = Dispatcher::new(world.clone());
 
     let mut edges = VerticalEdges::new(args.band_half_rows, args.edge_threshold);
     let mut lines = LineLandmarks::new(world.camera.focal_px, args.edge_threshold);
@@ -53,6 +92,11 @@ fn main() -> anyhow::Result<()> {
     while pace.next(&waiter, None)? != Step::Stop {
         expectations.drain(|e| {
             wanted.insert(e.landmark_index, *e);
+        })?;
+        requests.drain(|r| {
+            if r.request_id % n == k {
+                asked.insert(r.request_id, *r);
+            }
         })?;
         // Work on the newest frame only: a late worker skips, it does not fall further behind.
         let Some(frame) = frames.latest()? else {
@@ -75,6 +119,10 @@ fn main() -> anyhow::Result<()> {
                 sightings.send(&s)?;
             }
         }
+        for req in asked.values() {
+            results.send(&dispatcher.answer(&h, frame.pixels(), req))?;
+        }
+        asked.retain(|_, r| r.standing != 0);
         drop(frame);
         pace.done()?;
     }

@@ -35,23 +35,40 @@ pub fn build(
     height: u32,
     side: usize,
 ) -> Option<AppearanceTemplate> {
-    let [u, v] = world.camera.project(width, height, pose, point_m)?;
+    let mut t = AppearanceTemplate { pixels: GrayBuf::default(), origin: [0, 0], projection: [0.0, 0.0] };
+    build_into(&mut t, world, pose, point_m, [width, height], side).then_some(t)
+}
+
+/// [`build`] into `out`, reusing its pixels; false (and `out` unusable) when it cannot be built.
+pub fn build_into(
+    out: &mut AppearanceTemplate,
+    world: &World,
+    pose: [f64; 3],
+    point_m: [f64; 3],
+    [width, height]: [u32; 2],
+    side: usize,
+) -> bool {
+    let Some([u, v]) = world.camera.project(width, height, pose, point_m) else { return false };
     let half = side as f64 / 2.0;
     let (x0, y0) = ((u - half).round(), (v - half).round());
-    if x0 < 0.0 || y0 < 0.0 || x0 + side as f64 > f64::from(width) || y0 + side as f64 > f64::from(height) {
-        return None;
+    let fits = x0 >= 0.0
+        && y0 >= 0.0
+        && x0 + side as f64 <= f64::from(width)
+        && y0 + side as f64 <= f64::from(height);
+    if side == 0 || !fits {
+        return false;
     }
     let (x0, y0) = (x0 as usize, y0 as usize);
-    let pixels = GrayBuf::from_fn(side, side, |i, j| {
-        let r = harvey_camera::reflectance_at(
-            world,
-            pose,
-            width,
-            height,
-            (x0 + i) as f64 + 0.5,
-            (y0 + j) as f64 + 0.5,
-        );
-        (255.0 * r).round().clamp(0.0, 255.0) as u8
-    });
-    Some(AppearanceTemplate { pixels, origin: [x0, y0], projection: [u, v] })
+    let px = &mut out.pixels;
+    (px.width, px.height) = (side, side);
+    px.data.clear();
+    for j in 0..side {
+        px.data.extend((0..side).map(|i| {
+            let (pu, pv) = ((x0 + i) as f64 + 0.5, (y0 + j) as f64 + 0.5);
+            let r = harvey_camera::reflectance_at(world, pose, width, height, pu, pv);
+            (255.0 * r).round().clamp(0.0, 255.0) as u8
+        }));
+    }
+    (out.origin, out.projection) = ([x0, y0], [u, v]);
+    true
 }

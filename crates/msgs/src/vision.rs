@@ -1,0 +1,123 @@
+//! The vision workers' request/result protocol (`vision/requests`, `vision/results`): a request
+//! names the algorithm, its parameters and the image window (and, to correlate, the landmark
+//! and the pose to expect it from); the result carries the frame's `seq` and stamp.
+
+use crate::{Header, Message, Pose2, ZeroCopySend};
+
+/// Most items one result carries.
+pub const MAX_VISION_ITEMS: usize = 32;
+
+/// What a request asks for (`VisionRequest::algorithm`). The parameters, in `params` order:
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum VisionAlgorithm {
+    /// Reflectance-normalised correlation of the landmark's ray-traced appearance template
+    /// (000 §5.3–5.4), centred on the landmark's point (class I: half-way up; else its
+    /// position) moved by `params[2..5]` metres (x, y, z), to centre it on a vertex where
+    /// reflectances meet (000 §5.2). params: template side (px, default 16), minimum score
+    /// (default 0.9), dx, dy, dz. Item: `[u, v, score, expected_u, expected_v, 0]`, the point's
+    /// image position found and expected.
+    Correlate = 1,
+    /// Moravec interest operator (001 §2.4). params: window (5), threshold (2000), suppression
+    /// radius (3). Items: `[x, y, interest, 0, 0, 0]`, strongest first.
+    Moravec = 2,
+    /// Fast line finder (001 §2.1). params: buckets (8), offset (deg), minimum gradient (8),
+    /// minimum length (10), orientation range lo, hi (deg; NaN: any). Items:
+    /// `[x0, y0, x1, y1, mean_gradient, dispersion]`, longest first.
+    LineFinder = 3,
+    /// Fast region segmenter (001 §2.2). params: lo, hi (grey levels), minimum area (px).
+    /// Items: `[cx, cy, area, mean, sd, 0]`, largest first.
+    RegionSegmenter = 4,
+}
+
+impl VisionAlgorithm {
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        [Self::Correlate, Self::Moravec, Self::LineFinder, Self::RegionSegmenter]
+            .into_iter()
+            .find(|a| *a as u32 == raw)
+    }
+}
+
+/// How a request went (`VisionResult::status`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum VisionStatus {
+    Found = 0,
+    NotFound = 1,
+    WindowOutsideFrame = 2,
+    UnknownLandmark = 3,
+    UnknownAlgorithm = 4,
+    BadParameter = 5,
+    /// The template is empty, too large, or leaves the image.
+    BadTemplate = 6,
+    /// The frame cannot be read (encoding, size).
+    BadFrame = 7,
+}
+
+impl VisionStatus {
+    pub fn from_raw(raw: u32) -> Option<Self> {
+        use VisionStatus::*;
+        [
+            Found,
+            NotFound,
+            WindowOutsideFrame,
+            UnknownLandmark,
+            UnknownAlgorithm,
+            BadParameter,
+            BadTemplate,
+            BadFrame,
+        ]
+        .into_iter()
+        .find(|s| *s as u32 == raw)
+    }
+}
+
+/// A request to the vision workers.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/VisionRequest")]
+pub struct VisionRequest {
+    pub header: Header,
+    /// Chosen by the requester; results echo it. Workers sharing the load split by it.
+    pub request_id: u32,
+    /// [`VisionAlgorithm`] as its discriminant.
+    pub algorithm: u32,
+    /// 1: answer on every frame until a request with the same id replaces it; 0: the next frame.
+    pub standing: u32,
+    /// Index of the landmark in the world file (correlation).
+    pub landmark_index: u32,
+    /// The pose to build the template from (correlation).
+    pub expected: Pose2,
+    /// `[u0, v0, u1, v1]` in pixels; all zero: the whole frame.
+    pub window_px: [f32; 4],
+    pub params: [f32; 8],
+}
+crate::payloads::message!(VisionRequest);
+
+/// One found thing; the algorithm says what the six numbers are.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/VisionItem")]
+pub struct VisionItem {
+    pub values: [f32; 6],
+}
+
+/// A worker's answer to one request on one frame.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/VisionResult")]
+pub struct VisionResult {
+    /// `stamp_ns` is the frame's.
+    pub header: Header,
+    pub frame_seq: u64,
+    pub request_id: u32,
+    pub algorithm: u32,
+    /// [`VisionStatus`] as its discriminant.
+    pub status: u32,
+    /// Items found in all (`items` holds the first [`MAX_VISION_ITEMS`]).
+    pub found: u32,
+    pub count: u32,
+    pub reserved: u32,
+    pub items: [VisionItem; MAX_VISION_ITEMS],
+}
+crate::payloads::message!(VisionResult);

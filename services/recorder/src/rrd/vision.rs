@@ -1,0 +1,52 @@
+//! How vision results are drawn on the camera image: lines, corners, region centroids and
+//! correlation matches, one entity per request; failed requests go to the log.
+
+use harvey_msgs::{VisionAlgorithm, VisionResult, VisionStatus};
+
+use super::RrdWriter;
+use crate::RecordError;
+
+impl RrdWriter {
+    pub fn vision_result(&mut self, r: &VisionResult) -> Result<(), RecordError> {
+        self.at(r.header.stamp_ns);
+        let path = format!("camera/image/vision/{}", r.request_id);
+        let items = &r.items[..(r.count as usize).min(r.items.len())];
+        let status = VisionStatus::from_raw(r.status);
+        if status != Some(VisionStatus::Found) {
+            self.rec.log(path.as_str(), &rerun::Clear::flat()).map_err(|e| self.err(e))?;
+            if status != Some(VisionStatus::NotFound) {
+                let text =
+                    format!("vision request {} failed on frame {}: {:?}", r.request_id, r.frame_seq, status);
+                let log = rerun::TextLog::new(text).with_level(rerun::TextLogLevel::WARN);
+                self.rec.log("log", &log).map_err(|e| self.err(e))?;
+            }
+            return Ok(());
+        }
+        let colour = rerun::Color::from_rgb(255, 200, 0);
+        let points = |f: &dyn Fn(&[f32; 6]) -> String| {
+            let pts: Vec<[f32; 2]> = items.iter().map(|i| [i.values[0], i.values[1]]).collect();
+            let labels: Vec<String> = items.iter().map(|i| f(&i.values)).collect();
+            rerun::Points2D::new(pts).with_labels(labels).with_radii([2.5]).with_colors([colour])
+        };
+        let logged = match VisionAlgorithm::from_raw(r.algorithm) {
+            Some(VisionAlgorithm::LineFinder) => {
+                let strips: Vec<Vec<[f32; 2]>> = items
+                    .iter()
+                    .map(|i| vec![[i.values[0], i.values[1]], [i.values[2], i.values[3]]])
+                    .collect();
+                self.rec.log(path.as_str(), &rerun::LineStrips2D::new(strips).with_colors([colour]))
+            }
+            Some(VisionAlgorithm::Moravec) => {
+                self.rec.log(path.as_str(), &points(&|v| format!("{:.0}", v[2])))
+            }
+            Some(VisionAlgorithm::RegionSegmenter) => {
+                self.rec.log(path.as_str(), &points(&|v| format!("{:.0} px, mean {:.0}", v[2], v[3])))
+            }
+            Some(VisionAlgorithm::Correlate) => {
+                self.rec.log(path.as_str(), &points(&|v| format!("NC {:.3}", v[2])))
+            }
+            None => return Ok(()),
+        };
+        logged.map_err(|e| self.err(e))
+    }
+}

@@ -1,0 +1,166 @@
+//! The vision workers' request protocol on rendered frames: every algorithm answers with the
+//! frame's seq and stamp; bad requests get an error status; two workers sharing the requests
+//! give the answers one worker gives; and answering a frame allocates nothing once warm.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use harvey_camera::Renderer;
+use harvey_msgs::{Encoding, FrameHeader, Pose2, VisionAlgorithm, VisionRequest, VisionResult, VisionStatus};
+use harvey_vision_workers::dispatch::Dispatcher;
+use harvey_world::World;
+
+/// Counts allocations made by this test binary.
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+// SAFETY: forwards to the system allocator, only counting.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, l: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: same contract as ours.
+        unsafe { System.alloc(l) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        // SAFETY: same contract as ours.
+        unsafe { System.dealloc(p, l) }
+    }
+}
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn hallway() -> World {
+    harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
+}
+
+const POSE: [f64; 3] = [8.0, 0.0, 0.3];
+
+fn frame(w: &World, seq: u64) -> (FrameHeader, Vec<u8>) {
+    let mut r = Renderer::new(w, 640, 480, Encoding::Mono8);
+    let mut px = vec![0u8; r.frame_bytes()];
+    r.render(w, POSE, &mut px).expect("renders");
+    (FrameHeader::new(seq, seq * 100_000_000, 640, 480, Encoding::Mono8), px)
+}
+
+fn request(id: u32, algorithm: VisionAlgorithm) -> VisionRequest {
+    VisionRequest { request_id: id, algorithm: algorithm as u32, ..Default::default() }
+}
+
+fn sign_index(w: &World) -> u32 {
+    w.landmarks.iter().position(|l| l.name == "office-sign").expect("sign") as u32
+}
+
+fn requests(w: &World) -> Vec<VisionRequest> {
+    let expected = Pose2 { x_m: POSE[0], y_m: POSE[1], heading_rad: POSE[2] };
+    let mut lines = request(3, VisionAlgorithm::LineFinder);
+    lines.params[4..6].copy_from_slice(&[80.0, 100.0]); // near-vertical lines only
+    let mut regions = request(4, VisionAlgorithm::RegionSegmenter);
+    regions.params[..3].copy_from_slice(&[0.0, 90.0, 50.0]);
+    let mut windowed = request(5, VisionAlgorithm::Moravec);
+    windowed.window_px = [200.0, 100.0, 440.0, 380.0];
+    let mut sign = request(6, VisionAlgorithm::Correlate);
+    (sign.landmark_index, sign.expected) = (sign_index(w), expected);
+    // Its lower-left corner, where the sign meets the wall: a vertex (000 §5.2).
+    sign.params[..5].copy_from_slice(&[24.0, 0.9, -0.2, 0.0, -0.15]);
+    vec![request(2, VisionAlgorithm::Moravec), lines, regions, windowed, sign]
+}
+
+fn status(r: &VisionResult) -> VisionStatus {
+    VisionStatus::from_raw(r.status).expect("a known status")
+}
+
+#[test]
+fn every_algorithm_answers_with_the_frames_seq_and_stamp() {
+    let w = hallway();
+    let (h, px) = frame(&w, 7);
+    let mut d = Dispatcher::new(w.clone());
+    for req in requests(&w) {
+        let r = d.answer(&h, &px, &req);
+        assert_eq!((r.frame_seq, r.header.stamp_ns, r.request_id), (7, 700_000_000, req.request_id));
+        assert_eq!(status(&r), VisionStatus::Found, "request {}: {r:?}", req.request_id);
+        assert!(r.count > 0 && r.count <= r.found);
+    }
+    // Near-vertical lines are near-vertical; the windowed corners lie in the window.
+    let lines = d.answer(&h, &px, &requests(&w)[1]);
+    for i in &lines.items[..lines.count as usize] {
+        let v = i.values;
+        assert!((v[2] - v[0]).abs() <= (v[3] - v[1]).abs() * 0.2, "not vertical: {v:?}");
+    }
+    let corners = d.answer(&h, &px, &requests(&w)[3]);
+    for i in &corners.items[..corners.count as usize] {
+        assert!(
+            (200.0..440.0).contains(&i.values[0]) && (100.0..380.0).contains(&i.values[1]),
+            "{:?}",
+            i.values
+        );
+    }
+    // The sign's template, from the pose the frame was taken at, lands on its projection.
+    let sign = d.answer(&h, &px, &requests(&w)[4]);
+    let v = sign.items[0].values;
+    assert!((v[0] - v[3]).hypot(v[1] - v[4]) < 1.0 && v[2] > 0.99, "{v:?}");
+}
+
+#[test]
+fn bad_requests_get_error_results() {
+    let w = hallway();
+    let (h, px) = frame(&w, 1);
+    let mut d = Dispatcher::new(w.clone());
+    let mut outside = request(1, VisionAlgorithm::Moravec);
+    outside.window_px = [600.0, 400.0, 700.0, 480.0];
+    let mut unknown = request(2, VisionAlgorithm::Correlate);
+    unknown.landmark_index = 999;
+    let mut off_image = request(3, VisionAlgorithm::Correlate);
+    off_image.landmark_index = sign_index(&w);
+    off_image.expected = Pose2 { x_m: 8.0, y_m: 0.0, heading_rad: std::f64::consts::PI }; // looking away
+    let mut regions = request(4, VisionAlgorithm::RegionSegmenter);
+    regions.params[..2].copy_from_slice(&[200.0, 100.0]);
+    let bogus = VisionRequest { request_id: 5, algorithm: 77, ..Default::default() };
+    let mut nan = request(6, VisionAlgorithm::LineFinder);
+    nan.window_px = [f32::NAN, 0.0, 10.0, 10.0];
+    let cases = [
+        (outside, VisionStatus::WindowOutsideFrame),
+        (unknown, VisionStatus::UnknownLandmark),
+        (off_image, VisionStatus::BadTemplate),
+        (regions, VisionStatus::BadParameter),
+        (bogus, VisionStatus::UnknownAlgorithm),
+        (nan, VisionStatus::WindowOutsideFrame),
+    ];
+    for (req, want) in cases {
+        let r = d.answer(&h, &px, &req);
+        assert_eq!((status(&r), r.count), (want, 0), "request {}", req.request_id);
+    }
+    // A frame whose bytes do not fill its header.
+    let r = d.answer(&h, &px[..1000], &request(7, VisionAlgorithm::Moravec));
+    assert_eq!(status(&r), VisionStatus::BadFrame);
+    // And the worker still answers good requests afterwards.
+    assert_eq!(status(&d.answer(&h, &px, &requests(&w)[0])), VisionStatus::Found);
+}
+
+#[test]
+fn two_workers_sharing_the_requests_answer_as_one_and_allocate_nothing_once_warm() {
+    let w = hallway();
+    let (h1, px1) = frame(&w, 1);
+    let (h2, px2) = frame(&w, 2);
+    let reqs = requests(&w);
+    let mut one = Dispatcher::new(w.clone());
+    let mut shards = [Dispatcher::new(w.clone()), Dispatcher::new(w.clone())];
+    let strip = |mut r: VisionResult| {
+        r.header.seq = 0; // each worker numbers its own results
+        r
+    };
+    for (h, px) in [(&h1, &px1), (&h2, &px2)] {
+        for req in &reqs {
+            let alone = strip(one.answer(h, px, req));
+            let shared = strip(shards[(req.request_id % 2) as usize].answer(h, px, req));
+            assert_eq!(alone, shared, "request {}", req.request_id);
+        }
+    }
+    // Warm now: a third frame's answers allocate nothing.
+    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let mut out = [VisionResult::default(); 8];
+    for (o, req) in out.iter_mut().zip(&reqs) {
+        *o = one.answer(&h2, &px2, req);
+    }
+    let after = ALLOCATIONS.load(Ordering::Relaxed);
+    assert_eq!(after - before, 0, "allocations while answering a frame");
+    assert!(out[..reqs.len()].iter().all(|r| status(r) == VisionStatus::Found));
+}
