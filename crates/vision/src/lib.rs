@@ -2,6 +2,7 @@
 //! or a state machine with reusable buffers, no IO, no clock. The vision-workers service runs them
 //! on camera frames in shared memory, inside the windows it is asked to look in.
 
+pub mod depth;
 pub mod flf;
 pub mod frs;
 pub mod image;

@@ -1,0 +1,146 @@
+//! Depth from motion on rendered frames (001 §2.3, Table 1): the camera drives straight down the
+//! hallway towards a box on the floor; tracked points' depths sharpen with every frame, and the
+//! row-against-inverse-depth fit separates the box's points from the floor's.
+
+use harvey_camera::Renderer;
+use harvey_msgs::Encoding;
+use harvey_vision::depth::{DepthFromMotion, DepthParams, Track, obstacles};
+use harvey_vision::moravec::MoravecParams;
+use harvey_vision::{Gray, Rect};
+use harvey_world::{Wall, World};
+
+const W: u32 = 640;
+const H: u32 = 480;
+
+/// The hallway with a dark 0.4 x 0.4 x 0.5 m box, lighter on top half, 7 m ahead.
+fn world_with_box() -> World {
+    let mut w =
+        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads");
+    let corners = [[7.0, -0.2], [7.0, 0.2], [7.4, 0.2], [7.4, -0.2]];
+    let template = w.walls[0].clone();
+    for k in 0..4 {
+        let mut face: Wall = template.clone();
+        (face.from, face.to) = (corners[k], corners[(k + 1) % 4]);
+        (face.height_m, face.reflectance) = (0.5, 0.2);
+        face.regions.clear();
+        w.walls.push(face);
+    }
+    w
+}
+
+/// The true depth (along the optical axis) of what pixel `at` sees from `pose`, and whether it
+/// stands off the floor (a wall or the box: anything not floor).
+fn truth(w: &World, pose: [f64; 3], at: [f32; 2]) -> (f64, bool) {
+    let f = w.camera.focal_for(W);
+    let (cx, cy) = (f64::from(W) / 2.0, f64::from(H) / 2.0);
+    let left = (cx - f64::from(at[0])) / f;
+    let down = (f64::from(at[1]) - cy) / f;
+    let a = pose[2] + left.atan();
+    let floor_depth = w.camera.height_m / down;
+    match w.cast_ray([pose[0], pose[1]], [a.cos(), a.sin()], 1e3) {
+        Some(hit) => {
+            let depth = hit.distance_m * left.atan().cos();
+            let z = w.camera.height_m - down * depth;
+            // Standing: at least 10 cm off the floor (a wall's foot is floor to any camera).
+            if z >= 0.0 { (depth, z > 0.10) } else { (floor_depth, false) }
+        }
+        None => (floor_depth, false),
+    }
+}
+
+/// [`truth`] for a tracked feature: a corner on an occluding edge moves with the nearer
+/// surface, so when something within 2 px is more than 15 % nearer, that is what it tracks.
+fn feature_truth(w: &World, pose: [f64; 3], at: [f32; 2]) -> (f64, bool) {
+    let centre = truth(w, pose, at);
+    let offsets = (-2..=2).flat_map(|i| (-2..=2).map(move |j| [i as f32, j as f32]));
+    let nearest = offsets
+        .map(|d| truth(w, pose, [at[0] + d[0], at[1] + d[1]]))
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .unwrap_or(centre);
+    if nearest.0 < 0.85 * centre.0 { nearest } else { centre }
+}
+
+#[test]
+fn depths_sharpen_frame_by_frame_and_the_box_stands_off_the_floor() {
+    let w = world_with_box();
+    let mut r = Renderer::new(&w, W, H, Encoding::Mono8);
+    let mut px = vec![0u8; r.frame_bytes()];
+    let f = w.camera.focal_for(W) as f32;
+    let params = DepthParams {
+        foe: [W as f32 / 2.0, H as f32 / 2.0],
+        focal_px: f,
+        patch: 11,
+        startup_reach_px: 40.0,
+        update_reach_px: 4.0,
+        noise_px: 0.3,
+        min_score: 0.97,
+        recut_score: 0.995,
+        moravec: MoravecParams { window: 5, threshold: 3000, suppress_radius: 5, max_corners: 120 },
+    };
+    let mut dfm = DepthFromMotion::new(params);
+    let step = 0.15;
+    let mut rows = Vec::new();
+    let mut start_depth: Vec<f64> = Vec::new();
+    for k in 0..9 {
+        let travelled = k as f64 * step;
+        let pose = [travelled, 0.0, 0.0];
+        r.render(&w, pose, &mut px).expect("renders");
+        let img = Gray::new(&px, W as usize, H as usize, W as usize).expect("frame");
+        if k == 0 {
+            // Below the horizon, ahead of the robot: where obstacles would be.
+            let n = dfm.start(&img, Rect::new(200, 250, 440, 470), travelled).expect("starts");
+            assert!(n >= 20, "only {n} points to track");
+            // Each point's true depth at the start; it shrinks by the travel.
+            start_depth = dfm.tracks().map(|t| feature_truth(&w, pose, t.at).0).collect();
+            continue;
+        }
+        dfm.update(&img, travelled).expect("updates");
+        let errors: Vec<(f64, f64)> = dfm
+            .tracks()
+            .filter_map(|t| t.depth.map(|(z, sd)| (t, f64::from(z), f64::from(sd))))
+            .map(|(t, z, sd)| {
+                let true_z = start_depth[t.id] - travelled;
+                ((z - true_z).abs() / true_z, sd / true_z)
+            })
+            .collect();
+        let median = |mut v: Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        let (err, sd) =
+            (median(errors.iter().map(|e| e.0).collect()), median(errors.iter().map(|e| e.1).collect()));
+        println!(
+            "frame {k}: {} points, median depth error {:.1} %, median sd {:.1} %",
+            errors.len(),
+            100.0 * err,
+            100.0 * sd
+        );
+        rows.push((errors.len(), err, sd));
+    }
+    let (first, last) = (rows[0], rows[rows.len() - 1]);
+    assert!(last.0 >= 15, "{} points tracked to the end", last.0);
+    assert!(last.1 < 0.05, "final median error {:.3}", last.1);
+    assert!(last.1 < 0.5 * first.1 && last.2 < 0.3 * first.2, "no sharpening: {first:?} -> {last:?}");
+
+    // The box's points stand off the floor's ground line; the floor's lie on it.
+    let pose = [8.0 * step, 0.0, 0.0];
+    let tracks: Vec<&Track> = dfm.tracks().filter(|t| t.depth.is_some()).collect();
+    let off = obstacles(&tracks, params.foe[1], 2.0, 0.08, 0.1);
+    let judged: Vec<(&&Track, bool)> =
+        tracks.iter().zip(&off).filter_map(|(t, o)| o.map(|o| (t, o))).collect();
+    assert!(judged.len() + 2 >= tracks.len(), "only {} of {} points judged", judged.len(), tracks.len());
+    let (mut right, mut standing, mut on_box) = (0, 0, 0);
+    for &(t, is_obstacle) in &judged {
+        let (depth, stands) = feature_truth(&w, pose, t.at);
+        standing += usize::from(stands);
+        // The box's front face is 7 m from the start.
+        on_box += usize::from(stands && (depth - (7.0 - 8.0 * step)).abs() < 0.3);
+        right += usize::from(stands == is_obstacle);
+    }
+    let n = judged.len();
+    println!(
+        "{right} of {n} points classified right ({standing} off the floor, {on_box} of them on the box)"
+    );
+    assert!(on_box >= 3 && n - standing >= 3, "both kinds of point: {standing} of {n}");
+    assert!(right as f64 >= 0.85 * n as f64, "{right} of {n}");
+}
