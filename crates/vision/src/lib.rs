@@ -2,9 +2,11 @@
 //! or a state machine with reusable buffers, no IO, no clock. The vision-workers service runs them
 //! on camera frames in shared memory, inside the windows it is asked to look in.
 
+pub mod cues;
 pub mod depth;
 pub mod flf;
 pub mod frs;
+pub mod hough;
 pub mod image;
 pub mod moravec;
 pub mod nc;
