@@ -10,7 +10,9 @@ pub mod hough;
 pub mod image;
 pub mod moravec;
 pub mod nc;
+pub mod pyramid;
 pub mod regions;
 mod simd;
+pub mod stereo;
 
 pub use image::{Gray, GrayBuf, Rect, VisionError};

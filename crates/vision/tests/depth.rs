@@ -9,6 +9,8 @@ use harvey_vision::moravec::MoravecParams;
 use harvey_vision::{Gray, Rect};
 use harvey_world::{Wall, World};
 
+mod common;
+
 const W: u32 = 640;
 const H: u32 = 480;
 
@@ -28,36 +30,11 @@ fn world_with_box() -> World {
     w
 }
 
-/// The true depth (along the optical axis) of what pixel `at` sees from `pose`, and whether it
-/// stands off the floor (a wall or the box: anything not floor).
-fn truth(w: &World, pose: [f64; 3], at: [f32; 2]) -> (f64, bool) {
-    let f = w.camera.focal_for(W);
-    let (cx, cy) = (f64::from(W) / 2.0, f64::from(H) / 2.0);
-    let left = (cx - f64::from(at[0])) / f;
-    let down = (f64::from(at[1]) - cy) / f;
-    let a = pose[2] + left.atan();
-    let floor_depth = w.camera.height_m / down;
-    match w.cast_ray([pose[0], pose[1]], [a.cos(), a.sin()], 1e3) {
-        Some(hit) => {
-            let depth = hit.distance_m * left.atan().cos();
-            let z = w.camera.height_m - down * depth;
-            // Standing: at least 10 cm off the floor (a wall's foot is floor to any camera).
-            if z >= 0.0 { (depth, z > 0.10) } else { (floor_depth, false) }
-        }
-        None => (floor_depth, false),
-    }
-}
-
-/// [`truth`] for a tracked feature: a corner on an occluding edge moves with the nearer
-/// surface, so when something within 2 px is more than 15 % nearer, that is what it tracks.
+/// What a tracked feature sees: its depth, and whether it stands off the floor (at least 10 cm
+/// up: a wall's foot is floor to any camera).
 fn feature_truth(w: &World, pose: [f64; 3], at: [f32; 2]) -> (f64, bool) {
-    let centre = truth(w, pose, at);
-    let offsets = (-2..=2).flat_map(|i| (-2..=2).map(move |j| [i as f32, j as f32]));
-    let nearest = offsets
-        .map(|d| truth(w, pose, [at[0] + d[0], at[1] + d[1]]))
-        .min_by(|a, b| a.0.total_cmp(&b.0))
-        .unwrap_or(centre);
-    if nearest.0 < 0.85 * centre.0 { nearest } else { centre }
+    let (depth, height) = common::feature(w, [W, H], pose, at);
+    (depth, height > 0.10)
 }
 
 #[test]
