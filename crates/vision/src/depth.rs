@@ -170,7 +170,7 @@ impl DepthFromMotion {
                     t.lost = true;
                     continue;
                 }
-                t.patch = cut(img, cx, cy, half)?;
+                t.patch.crop_from(img, Rect::new(cx - half, cy - half, cx + half + 1, cy + half + 1))?;
                 t.patch_at = at;
             }
         }

@@ -139,12 +139,19 @@ impl GrayBuf {
 
     /// Copies `r` of `img` out.
     pub fn crop(img: &Gray<'_>, r: Rect) -> Result<Self, VisionError> {
-        let r = r.inside(img.width, img.height)?;
-        let mut out =
-            Self { width: r.width(), height: r.height(), data: Vec::with_capacity(r.width() * r.height()) };
-        for y in r.y0..r.y1 {
-            out.data.extend_from_slice(&img.row(y)[r.x0..r.x1]);
-        }
+        let mut out = Self::default();
+        out.crop_from(img, r)?;
         Ok(out)
+    }
+
+    /// Copies `r` of `img` into this buffer, reusing its memory.
+    pub fn crop_from(&mut self, img: &Gray<'_>, r: Rect) -> Result<(), VisionError> {
+        let r = r.inside(img.width, img.height)?;
+        (self.width, self.height) = (r.width(), r.height());
+        self.data.clear();
+        for y in r.y0..r.y1 {
+            self.data.extend_from_slice(&img.row(y)[r.x0..r.x1]);
+        }
+        Ok(())
     }
 }

@@ -91,7 +91,7 @@ impl Stereo {
             if win.width() < p.patch {
                 continue;
             }
-            self.patch = GrayBuf::crop(left, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?;
+            self.patch.crop_from(left, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?;
             match &mut self.template {
                 Some(t) => t.set(&self.patch)?,
                 None => self.template = Some(Template::new(&self.patch)?),
