@@ -10,6 +10,7 @@ pub mod hough;
 pub mod image;
 pub mod moravec;
 pub mod nc;
+pub mod path;
 pub mod pyramid;
 pub mod regions;
 mod simd;

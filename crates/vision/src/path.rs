@@ -1,0 +1,140 @@
+//! Path following with the line finder (001 §2.1): the line fragments near each predicted path
+//! edge (close to it, of like orientation, below the vanishing point) are grouped into one edge
+//! by the length-weighted centre of their midpoints and their length-weighted orientation; the
+//! two edges give the centreline, and the fragments' total length is the confidence. Each fit
+//! is fed forward as the next frame's prediction; when confidence falls short, the tolerances
+//! are widened once before the path counts as lost.
+
+use crate::flf::Line;
+
+/// An image line: a point on it and its direction (radians, image x right, y down).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ImageLine {
+    pub point: [f32; 2],
+    pub angle: f32,
+}
+
+impl ImageLine {
+    pub fn through(a: [f32; 2], b: [f32; 2]) -> Self {
+        Self { point: a, angle: (b[1] - a[1]).atan2(b[0] - a[0]) }
+    }
+
+    /// Perpendicular distance of `p` from the line.
+    pub fn distance(&self, p: [f32; 2]) -> f32 {
+        let (c, s) = (self.angle.cos(), self.angle.sin());
+        ((p[0] - self.point[0]) * s - (p[1] - self.point[1]) * c).abs()
+    }
+
+    /// The x where the line crosses row `v`.
+    pub fn x_at(&self, v: f32) -> f32 {
+        let (c, s) = (self.angle.cos(), self.angle.sin());
+        if s.abs() < 1e-6 { self.point[0] } else { self.point[0] + (v - self.point[1]) * c / s }
+    }
+
+    /// Where two lines cross.
+    pub fn cross(&self, o: &ImageLine) -> Option<[f32; 2]> {
+        let (d1, d2) = ([self.angle.cos(), self.angle.sin()], [o.angle.cos(), o.angle.sin()]);
+        let den = d1[0] * d2[1] - d1[1] * d2[0];
+        if den.abs() < 1e-6 {
+            return None;
+        }
+        let (dx, dy) = (o.point[0] - self.point[0], o.point[1] - self.point[1]);
+        let t = (dx * d2[1] - dy * d2[0]) / den;
+        Some([self.point[0] + t * d1[0], self.point[1] + t * d1[1]])
+    }
+}
+
+/// Tolerances of the grouping.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathParams {
+    /// A fragment's midpoint within this distance of the predicted edge (pixels)…
+    pub max_distance_px: f32,
+    /// …and its direction within this angle of it (radians).
+    pub max_angle: f32,
+    /// Least total fragment length (pixels) of a confident fit.
+    pub min_confidence: f32,
+}
+
+/// One frame's path: both edges, the centreline (through the vanishing point and the middle of
+/// the path at the image's bottom row), and the confidence.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathFit {
+    pub left: ImageLine,
+    pub right: ImageLine,
+    pub centreline: ImageLine,
+    pub vanishing: [f32; 2],
+    /// Total length of the fragments used (pixels).
+    pub confidence: f32,
+}
+
+/// Groups the fragments of one edge; `None` when none qualifies.
+fn edge(lines: &[Line], predicted: &ImageLine, horizon_v: f32, p: &PathParams) -> Option<(ImageLine, f32)> {
+    let (mut w, mut mx, mut my, mut vx, mut vy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for l in lines {
+        let mid = [(l.from[0] + l.to[0]) / 2.0, (l.from[1] + l.to[1]) / 2.0];
+        let dir = (l.to[1] - l.from[1]).atan2(l.to[0] - l.from[0]);
+        let mut turn = (dir - predicted.angle).rem_euclid(std::f32::consts::PI);
+        turn = turn.min(std::f32::consts::PI - turn);
+        if mid[1] <= horizon_v || turn > p.max_angle || predicted.distance(mid) > p.max_distance_px {
+            continue;
+        }
+        // Directions averaged as doubled-angle vectors: a line and its reverse agree.
+        (w, mx, my) = (w + l.length, mx + l.length * mid[0], my + l.length * mid[1]);
+        (vx, vy) = (vx + l.length * (2.0 * dir).cos(), vy + l.length * (2.0 * dir).sin());
+    }
+    (w > 0.0).then(|| (ImageLine { point: [mx / w, my / w], angle: 0.5 * vy.atan2(vx) }, w))
+}
+
+/// One grouping of `lines` against the predicted edges, rows above `horizon_v` ignored.
+pub fn group(
+    lines: &[Line],
+    left: &ImageLine,
+    right: &ImageLine,
+    horizon_v: f32,
+    bottom_v: f32,
+    p: &PathParams,
+) -> Option<PathFit> {
+    let (l, wl) = edge(lines, left, horizon_v, p)?;
+    let (r, wr) = edge(lines, right, horizon_v, p)?;
+    let vanishing = l.cross(&r)?;
+    let bottom = [(l.x_at(bottom_v) + r.x_at(bottom_v)) / 2.0, bottom_v];
+    Some(PathFit {
+        left: l,
+        right: r,
+        centreline: ImageLine::through(vanishing, bottom),
+        vanishing,
+        confidence: wl + wr,
+    })
+}
+
+/// Feed-forward tracking of the path from frame to frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PathTracker {
+    pub left: ImageLine,
+    pub right: ImageLine,
+    pub horizon_v: f32,
+    pub bottom_v: f32,
+    pub params: PathParams,
+}
+
+impl PathTracker {
+    /// Bootstrap: the edges predicted from the map and the robot's pose (LTM and the spatial
+    /// uncertainty map).
+    pub fn new(left: ImageLine, right: ImageLine, horizon_v: f32, bottom_v: f32, params: PathParams) -> Self {
+        Self { left, right, horizon_v, bottom_v, params }
+    }
+
+    /// Update with a frame's lines: group against the prediction; if not confident, once more
+    /// with doubled tolerances; a confident fit becomes the next prediction. `None`: lost.
+    pub fn update(&mut self, lines: &[Line]) -> Option<PathFit> {
+        let p = self.params;
+        let wide = PathParams { max_distance_px: 2.0 * p.max_distance_px, max_angle: 2.0 * p.max_angle, ..p };
+        let fit = [p, wide].into_iter().find_map(|q| {
+            group(lines, &self.left, &self.right, self.horizon_v, self.bottom_v, &q)
+                .filter(|f| f.confidence >= p.min_confidence)
+        })?;
+        // The vanishing point bounds the fragments of the next frame.
+        (self.left, self.right, self.horizon_v) = (fit.left, fit.right, fit.vanishing[1]);
+        Some(fit)
+    }
+}
