@@ -25,7 +25,7 @@ fn path(vx: f32, xl: f32, xr: f32, hide_right: bool) -> GrayBuf {
                 inside(x as f32 + (k % 4) as f32 / 4.0 + 0.125, y as f32 + (k / 4) as f32 / 4.0 + 0.125)
             })
             .count();
-        let texture = ((x * 7 + y * 13) % 5) as usize;
+        let texture = (x * 7 + y * 13) % 5;
         (50 + texture + n * 130 / 16) as u8
     })
 }
