@@ -47,6 +47,18 @@ struct Row {
     reference_us: f64,
 }
 
+impl Row {
+    fn new(kernel: &'static str, size: &str, scope: String, window: Rect, template: Rect) -> Self {
+        Self { kernel, size: size.to_owned(), scope, window, template, harvey_us: 0.0, reference_us: 0.0 }
+    }
+}
+
+/// Times Harvey's kernel and the reference, in the same run.
+fn measure(mut row: Row, harvey: impl FnMut(), reference: impl FnMut()) -> Row {
+    (row.harvey_us, row.reference_us) = (time(harvey), time(reference));
+    row
+}
+
 fn frame(world: &harvey_world::World, w: u32, h: u32) -> GrayBuf {
     let mut r = Renderer::new(world, w, h, Encoding::Mono8);
     let mut px = vec![0u8; r.frame_bytes()];
@@ -104,21 +116,16 @@ fn bench_nc(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     {
         let m = c.best(img, win, &tmpl).expect("correlates");
         assert_eq!((m.x, m.y), (tr.x0, tr.y0), "the template is found where it was cut");
-        let harvey_us = time(|| {
-            black_box(c.best(img, win, &tmpl).expect("correlates"));
-        });
-        let reference_us = time(|| {
-            black_box(reference::nc_best(img, win, &t));
-        });
-        rows.push(Row {
-            kernel: "normalised correlation 16x16",
-            size: size.to_owned(),
-            scope,
-            window: win,
-            template: tr,
-            harvey_us,
-            reference_us,
-        });
+        let kernel = "normalised correlation 16x16";
+        rows.push(measure(
+            Row::new(kernel, size, scope, win, tr),
+            || {
+                black_box(c.best(img, win, &tmpl).expect("correlates"));
+            },
+            || {
+                black_box(reference::nc_best(img, win, &t));
+            },
+        ));
     }
 }
 
@@ -129,21 +136,16 @@ fn bench_moravec(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     for (scope, win) in [("full frame".to_owned(), img.full()), ("64x64 window".to_owned(), win)] {
         let ours = m.corners(img, win, &p).expect("runs").len();
         assert!(ours > 0, "no corner found in {scope}");
-        let harvey_us = time(|| {
-            black_box(m.corners(img, win, &p).expect("runs").len());
-        });
-        let reference_us = time(|| {
-            black_box(reference::moravec(img, win, p.window, p.threshold, p.suppress_radius));
-        });
-        rows.push(Row {
-            kernel: "Moravec 5x5",
-            size: size.to_owned(),
-            scope,
-            window: win,
-            template: Rect::default(),
-            harvey_us,
-            reference_us,
-        });
+        let kernel = "Moravec 5x5";
+        rows.push(measure(
+            Row::new(kernel, size, scope, win, Rect::default()),
+            || {
+                black_box(m.corners(img, win, &p).expect("runs").len());
+            },
+            || {
+                black_box(reference::moravec(img, win, p.window, p.threshold, p.suppress_radius));
+            },
+        ));
     }
 }
 
@@ -153,21 +155,16 @@ fn bench_flf(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     let win = around(img, textured(img, 16), 96);
     for (scope, win) in [("full frame".to_owned(), img.full()), ("96x96 window".to_owned(), win)] {
         assert!(!f.lines(img, win, &p).expect("runs").is_empty(), "no line in {scope}");
-        let harvey_us = time(|| {
-            black_box(f.lines(img, win, &p).expect("runs").len());
-        });
-        let reference_us = time(|| {
-            black_box(reference::flf(img, win, p.buckets, p.min_gradient, f64::from(p.min_length)));
-        });
-        rows.push(Row {
-            kernel: "fast line finder",
-            size: size.to_owned(),
-            scope,
-            window: win,
-            template: Rect::default(),
-            harvey_us,
-            reference_us,
-        });
+        let kernel = "fast line finder";
+        rows.push(measure(
+            Row::new(kernel, size, scope, win, Rect::default()),
+            || {
+                black_box(f.lines(img, win, &p).expect("runs").len());
+            },
+            || {
+                black_box(reference::flf(img, win, p.buckets, p.min_gradient, f64::from(p.min_length)));
+            },
+        ));
     }
 }
 
@@ -184,21 +181,16 @@ fn bench_frs(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     for (scope, win) in [("full frame".to_owned(), img.full()), ("96x96 window".to_owned(), win)] {
         let n = f.segment(img, win, &ranges, 20).expect("segments").len();
         assert_eq!(n, reference::frs(img, win, &plain, 20), "region count in {scope}");
-        let harvey_us = time(|| {
-            black_box(f.segment(img, win, &ranges, 20).expect("segments").len());
-        });
-        let reference_us = time(|| {
-            black_box(reference::frs(img, win, &plain, 20));
-        });
-        rows.push(Row {
-            kernel: "fast region segmenter + stats",
-            size: size.to_owned(),
-            scope,
-            window: win,
-            template: Rect::default(),
-            harvey_us,
-            reference_us,
-        });
+        let kernel = "fast region segmenter + stats";
+        rows.push(measure(
+            Row::new(kernel, size, scope, win, Rect::default()),
+            || {
+                black_box(f.segment(img, win, &ranges, 20).expect("segments").len());
+            },
+            || {
+                black_box(reference::frs(img, win, &plain, 20));
+            },
+        ));
     }
 }
 

@@ -104,30 +104,7 @@ pub fn flf(img: &Gray<'_>, win: Rect, buckets: u8, min_gradient: f32, min_length
             }
         }
     }
-    let mut parent: Vec<usize> = (0..w * h).collect();
-    fn root(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
-        }
-        i
-    }
-    for y in 0..h {
-        for x in 0..w {
-            let b = bucket[y * w + x];
-            if b == 0 {
-                continue;
-            }
-            for (dx, dy) in [(-1isize, 0isize), (-1, -1), (0, -1), (1, -1)] {
-                let (nx, ny) = (x as isize + dx, y as isize + dy);
-                if nx >= 0 && ny >= 0 && (nx as usize) < w && bucket[ny as usize * w + nx as usize] == b {
-                    let (a, c) =
-                        (root(&mut parent, y * w + x), root(&mut parent, ny as usize * w + nx as usize));
-                    parent[a.max(c)] = a.min(c);
-                }
-            }
-        }
-    }
+    let mut parent = label_regions(&bucket, w, h);
     let mut sums = std::collections::HashMap::<usize, [f64; 6]>::new();
     for y in 0..h {
         for x in 0..w {
@@ -164,14 +141,26 @@ pub fn frs(img: &Gray<'_>, win: Rect, ranges: &[(u8, u8, u8)], min_area: usize) 
             class[y * w + x] = ranges.iter().find(|r| (r.0..=r.1).contains(&v)).map_or(0, |r| r.2);
         }
     }
-    let mut parent: Vec<usize> = (0..w * h).collect();
-    fn root(p: &mut [usize], mut i: usize) -> usize {
-        while p[i] != i {
-            p[i] = p[p[i]];
-            i = p[i];
+    let mut parent = label_regions(&class, w, h);
+    let mut stats = std::collections::HashMap::<usize, [f64; 5]>::new();
+    for y in 0..h {
+        for x in 0..w {
+            if class[y * w + x] != 0 {
+                let v = f64::from(img.at(win.x0 + x, win.y0 + y));
+                let s = stats.entry(root(&mut parent, y * w + x)).or_default();
+                for (k, a) in [1.0, x as f64, y as f64, v, v * v].into_iter().enumerate() {
+                    s[k] += a;
+                }
+            }
         }
-        i
     }
+    stats.values().filter(|s| s[0] >= min_area as f64).count()
+}
+
+/// Pixel-by-pixel union-find of equal non-zero classes (left and the three above, so
+/// 8-connected); returns the parent forest for [`root`].
+fn label_regions(class: &[u8], w: usize, h: usize) -> Vec<usize> {
+    let mut parent: Vec<usize> = (0..w * h).collect();
     for y in 0..h {
         for x in 0..w {
             let c = class[y * w + x];
@@ -188,17 +177,14 @@ pub fn frs(img: &Gray<'_>, win: Rect, ranges: &[(u8, u8, u8)], min_area: usize) 
             }
         }
     }
-    let mut stats = std::collections::HashMap::<usize, [f64; 5]>::new();
-    for y in 0..h {
-        for x in 0..w {
-            if class[y * w + x] != 0 {
-                let v = f64::from(img.at(win.x0 + x, win.y0 + y));
-                let s = stats.entry(root(&mut parent, y * w + x)).or_default();
-                for (k, a) in [1.0, x as f64, y as f64, v, v * v].into_iter().enumerate() {
-                    s[k] += a;
-                }
-            }
-        }
+    parent
+}
+
+/// The region (root pixel) of pixel `i`, halving paths on the way.
+fn root(p: &mut [usize], mut i: usize) -> usize {
+    while p[i] != i {
+        p[i] = p[p[i]];
+        i = p[i];
     }
-    stats.values().filter(|s| s[0] >= min_area as f64).count()
+    i
 }
