@@ -28,11 +28,22 @@ pub enum VisionAlgorithm {
     /// Fast region segmenter (001 §2.2). params: lo, hi (grey levels), minimum area (px).
     /// Items: `[cx, cy, area, mean, sd, 0]`, largest first.
     RegionSegmenter = 4,
+    /// Phototropic perception (004 §4.1): the largest region within `params[0]` grey levels
+    /// (default 20) of the brightest pixel, of at least `params[1]` pixels (default 20).
+    /// Item: `[cx, cy, area, mean, 0, 0]`.
+    Phototropic = 5,
+    /// Activity detection (004 §4.1), best as a standing request: the motion over the last
+    /// `params[2]` frames (default 4) of the window (which must keep its size), each frame
+    /// pair's absolute difference (`params[0]` = 0) or one vote per difference over
+    /// `params[1]` (`params[0]` = 1, default threshold 20). Item: `[cx, cy, strength, 0, 0, 0]`,
+    /// from the second frame on.
+    Activity = 6,
 }
 
 impl VisionAlgorithm {
     pub fn from_raw(raw: u32) -> Option<Self> {
-        [Self::Correlate, Self::Moravec, Self::LineFinder, Self::RegionSegmenter]
+        use VisionAlgorithm::*;
+        [Correlate, Moravec, LineFinder, RegionSegmenter, Phototropic, Activity]
             .into_iter()
             .find(|a| *a as u32 == raw)
     }

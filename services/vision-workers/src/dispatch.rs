@@ -7,6 +7,7 @@ use harvey_msgs::{
     Encoding, FrameHeader, Header, MAX_VISION_ITEMS, VisionAlgorithm, VisionItem, VisionRequest,
     VisionResult, VisionStatus,
 };
+use harvey_vision::cues::{ActivityDetector, ActivityVote, brightest};
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::moravec::{Moravec, MoravecParams};
@@ -26,6 +27,8 @@ pub struct Dispatcher {
     moravec: Moravec,
     flf: Flf,
     frs: Frs,
+    /// Activity detection keeps frames: one detector per (standing) request.
+    activity: std::collections::BTreeMap<u32, ActivityDetector>,
     seq: u64,
 }
 
@@ -58,6 +61,7 @@ impl Dispatcher {
             moravec: Moravec::default(),
             flf: Flf::default(),
             frs: Frs::default(),
+            activity: std::collections::BTreeMap::new(),
             seq: 0,
         }
     }
@@ -154,6 +158,35 @@ impl Dispatcher {
                 let regions = self.frs.segment(&img, window, &ranges, param(req, 2, 20.0) as u32);
                 for r in regions.map_err(|e| status_of(&e))? {
                     push([r.centroid[0], r.centroid[1], r.area as f32, r.mean, r.sd, 0.0]);
+                }
+            }
+            VisionAlgorithm::Phototropic => {
+                let (margin, area) = (param(req, 0, 20.0), param(req, 1, 20.0));
+                if !(0.0..=255.0).contains(&margin) || area < 1.0 {
+                    return Err(VisionStatus::BadParameter);
+                }
+                let found = brightest(&mut self.frs, &img, window, margin as u8, area as u32)
+                    .map_err(|e| status_of(&e))?;
+                if let Some(r) = found {
+                    push([r.centroid[0], r.centroid[1], r.area as f32, r.mean, 0.0, 0.0]);
+                }
+            }
+            VisionAlgorithm::Activity => {
+                let vote = match req.params[0] {
+                    0.0 => ActivityVote::Difference,
+                    1.0 => ActivityVote::Threshold(param(req, 1, 20.0).clamp(0.0, 255.0) as u8),
+                    _ => return Err(VisionStatus::BadParameter),
+                };
+                let depth = param(req, 2, 4.0) as usize;
+                let detector =
+                    self.activity.entry(req.request_id).or_insert_with(|| ActivityDetector::new(vote, depth));
+                if detector.vote != vote {
+                    *detector = ActivityDetector::new(vote, depth);
+                }
+                if let Some(a) = detector.push(&img, window).map_err(|e| status_of(&e))?
+                    && a.strength > 0.0
+                {
+                    push([a.centroid[0], a.centroid[1], a.strength, 0.0, 0.0, 0.0]);
                 }
             }
             VisionAlgorithm::Correlate => {

@@ -3,20 +3,22 @@
 //! give the answers one worker gives; and answering a frame allocates nothing once warm.
 
 use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::cell::Cell;
 
 use harvey_camera::Renderer;
 use harvey_msgs::{Encoding, FrameHeader, Pose2, VisionAlgorithm, VisionRequest, VisionResult, VisionStatus};
 use harvey_vision_workers::dispatch::Dispatcher;
 use harvey_world::World;
 
-/// Counts allocations made by this test binary.
+/// Counts the allocations each thread makes (tests run side by side in threads).
 struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
 // SAFETY: forwards to the system allocator, only counting.
 unsafe impl GlobalAlloc for Counting {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        let _ = ALLOCATIONS.try_with(|c| c.set(c.get() + 1));
         // SAFETY: same contract as ours.
         unsafe { System.alloc(l) }
     }
@@ -154,13 +156,42 @@ fn two_workers_sharing_the_requests_answer_as_one_and_allocate_nothing_once_warm
             assert_eq!(alone, shared, "request {}", req.request_id);
         }
     }
+    // The counter counts: a fresh worker's first answers grow its buffers.
+    let cold = ALLOCATIONS.with(Cell::get);
+    let mut fresh = Dispatcher::new(w.clone());
+    reqs.iter().for_each(|req| drop(fresh.answer(&h2, &px2, req)));
+    assert!(ALLOCATIONS.with(Cell::get) > cold, "the counting allocator sees allocations");
     // Warm now: a third frame's answers allocate nothing.
-    let before = ALLOCATIONS.load(Ordering::Relaxed);
+    let before = ALLOCATIONS.with(Cell::get);
     let mut out = [VisionResult::default(); 8];
     for (o, req) in out.iter_mut().zip(&reqs) {
         *o = one.answer(&h2, &px2, req);
     }
-    let after = ALLOCATIONS.load(Ordering::Relaxed);
+    let after = ALLOCATIONS.with(Cell::get);
     assert_eq!(after - before, 0, "allocations while answering a frame");
     assert!(out[..reqs.len()].iter().all(|r| status(r) == VisionStatus::Found));
+}
+
+#[test]
+fn phototropic_and_activity_requests() {
+    let w = hallway();
+    let (h, px) = frame(&w, 1);
+    let mut d = Dispatcher::new(w.clone());
+    let light = d.answer(&h, &px, &request(8, VisionAlgorithm::Phototropic));
+    assert_eq!(status(&light), VisionStatus::Found, "{light:?}");
+    let [cx, cy] = [light.items[0].values[0] as usize, light.items[0].values[1] as usize];
+    let brightest = *px.iter().max().expect("pixels");
+    assert!(px[cy * 640 + cx] + 20 >= brightest, "the centroid lies in the bright region");
+    // Activity (a standing request): nothing moves between two identical frames, then the view
+    // changes and the activity is found.
+    let mut act = request(9, VisionAlgorithm::Activity);
+    (act.standing, act.params[0], act.params[1]) = (1, 1.0, 15.0);
+    assert_eq!(status(&d.answer(&h, &px, &act)), VisionStatus::NotFound, "one frame: nothing yet");
+    assert_eq!(status(&d.answer(&h, &px, &act)), VisionStatus::NotFound, "no motion");
+    let mut moved = Renderer::new(&w, 640, 480, Encoding::Mono8);
+    let mut px2 = vec![0u8; moved.frame_bytes()];
+    moved.render(&w, [POSE[0] + 0.3, POSE[1], POSE[2]], &mut px2).expect("renders");
+    let r = d.answer(&FrameHeader::new(3, 300_000_000, 640, 480, Encoding::Mono8), &px2, &act);
+    assert_eq!(status(&r), VisionStatus::Found, "{r:?}");
+    assert!(r.items[0].values[2] > 0.0);
 }

@@ -42,6 +42,12 @@ impl RrdWriter {
             Some(VisionAlgorithm::RegionSegmenter) => {
                 self.rec.log(path.as_str(), &points(&|v| format!("{:.0} px, mean {:.0}", v[2], v[3])))
             }
+            Some(VisionAlgorithm::Phototropic) => {
+                self.rec.log(path.as_str(), &points(&|v| format!("light {:.0} px", v[2])))
+            }
+            Some(VisionAlgorithm::Activity) => {
+                self.rec.log(path.as_str(), &points(&|v| format!("activity {:.1}", v[2])))
+            }
             Some(VisionAlgorithm::Correlate) => {
                 self.rec.log(path.as_str(), &points(&|v| format!("NC {:.3}", v[2])))
             }
