@@ -159,7 +159,9 @@ fn two_workers_sharing_the_requests_answer_as_one_and_allocate_nothing_once_warm
     // The counter counts: a fresh worker's first answers grow its buffers.
     let cold = ALLOCATIONS.with(Cell::get);
     let mut fresh = Dispatcher::new(w.clone());
-    reqs.iter().for_each(|req| drop(fresh.answer(&h2, &px2, req)));
+    for req &reqs {
+        let _ = fresh.answer(&h2, &px2, req);
+    }
     assert!(ALLOCATIONS.with(Cell::get) > cold, "the counting allocator sees allocations");
     // Warm now: a third frame's answers allocate nothing.
     let before = ALLOCATIONS.with(Cell::get);
