@@ -159,7 +159,7 @@ fn two_workers_sharing_the_requests_answer_as_one_and_allocate_nothing_once_warm
     // The counter counts: a fresh worker's first answers grow its buffers.
     let cold = ALLOCATIONS.with(Cell::get);
     let mut fresh = Dispatcher::new(w.clone());
-    for req &reqs {
+    for req in &reqs {
         let _ = fresh.answer(&h2, &px2, req);
     }
     assert!(ALLOCATIONS.with(Cell::get) > cold, "the counting allocator sees allocations");
