@@ -67,3 +67,28 @@ fn a_ray_traced_template_is_found_within_a_pixel_of_the_true_projection() {
     }
     assert!(worst <= 1.0, "worst error {worst:.2} px");
 }
+
+#[test]
+fn selected_vertices_are_found_where_they_project() {
+    // Landmark selection (000 §5.2) then matching (000 §5.4), from the pose the frame was taken at.
+    let w = hallway();
+    let truth = [8.0, 0.0, 0.3];
+    let img = frame(&w, truth, 9);
+    let gray = Gray::new(&img, 640, 480, 640).expect("frame");
+    let chosen = harvey_vision_workers::selection::select(&w, truth, [640, 480], 40.0, 12.0, 0.15);
+    assert!(chosen.len() >= 4, "{chosen:?}");
+    let mut c = Correlator::default();
+    for v in chosen.iter().take(8) {
+        let t = templates::build(&w, truth, v.point_m, 640, 480, 24).expect("template");
+        let [eu, ev] = t.projection;
+        let win =
+            Rect::new((eu - 32.0) as usize, (ev - 32.0) as usize, (eu + 32.0) as usize, (ev + 32.0) as usize);
+        let m = c.best(&gray, win, &Template::new(&t.pixels).expect("template")).expect("correlates");
+        let found = [
+            m.centre[0] as f64 - 12.0 + (eu - t.origin[0] as f64),
+            m.centre[1] as f64 - 12.0 + (ev - t.origin[1] as f64),
+        ];
+        let err = (found[0] - eu).hypot(found[1] - ev);
+        assert!(err <= 1.0 && m.score > 0.99, "vertex {:?}: error {err:.2} px, score {}", v.point_m, m.score);
+    }
+}

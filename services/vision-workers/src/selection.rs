@@ -1,0 +1,103 @@
+//! Landmark selection from the world model (000 §5.2): vertices where regions of differing
+//! reflectance meet, that is the corners of the regions painted on walls (signs, doors, panels),
+//! kept when they are in view from the expected pose, not hidden by a nearer wall, and
+//! distinctive: the reflectance step across them is large. These are the points whose
+//! appearance templates (`templates.rs`) correlation then finds.
+
+use harvey_world::World;
+
+/// A selected vertex.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Vertex {
+    pub point_m: [f64; 3],
+    /// Where it should appear from the expected pose.
+    pub image_px: [f64; 2],
+    /// Reflectance of the region minus that of the wall round it (its sign tells which is
+    /// lighter).
+    pub contrast: f64,
+    pub wall: usize,
+}
+
+/// The vertices visible from `pose` in a `width x height` image, at least `margin_px` inside it,
+/// within `range_m`, with a reflectance step of at least `min_contrast`; strongest first.
+pub fn select(
+    world: &World,
+    pose: [f64; 3],
+    [width, height]: [u32; 2],
+    margin_px: f64,
+    range_m: f64,
+    min_contrast: f64,
+) -> Vec<Vertex> {
+    let mut out = Vec::new();
+    for (i, w) in world.walls.iter().enumerate() {
+        let len = w.length_m();
+        if len <= 0.0 {
+            continue;
+        }
+        let dir = [(w.to[0] - w.from[0]) / len, (w.to[1] - w.from[1]) / len];
+        for r in &w.regions {
+            let contrast = r.reflectance - w.reflectance;
+            if contrast.abs() < min_contrast {
+                continue;
+            }
+            for along in r.along_m {
+                for z in r.height_m {
+                    // A region's edge on the floor or the wall's end is no vertex of two regions.
+                    if z <= 0.0 || z >= w.height_m || along <= 0.0 || along >= len {
+                        continue;
+                    }
+                    let p = [w.from[0] + dir[0] * along, w.from[1] + dir[1] * along, z];
+                    let Some([u, v]) = world.camera.project(width, height, pose, p) else { continue };
+                    let inside = |a: f64, max: u32| a >= margin_px && a <= f64::from(max) - margin_px;
+                    let (dx, dy) = (p[0] - pose[0], p[1] - pose[1]);
+                    let dist = dx.hypot(dy);
+                    if !inside(u, width) || !inside(v, height) || dist > range_m {
+                        continue;
+                    }
+                    // Nothing nearer on the way (the vertex's own wall is hit at its distance).
+                    let hit = world.cast_ray([pose[0], pose[1]], [dx / dist, dy / dist], dist + 1.0);
+                    if hit.is_some_and(|h| h.distance_m < dist - 0.05) {
+                        continue;
+                    }
+                    out.push(Vertex { point_m: p, image_px: [u, v], contrast, wall: i });
+                }
+            }
+        }
+    }
+    out.sort_by(|a, b| {
+        b.contrast.abs().total_cmp(&a.contrast.abs()).then(a.image_px[0].total_cmp(&b.image_px[0]))
+    });
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hallway() -> World {
+        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
+    }
+
+    #[test]
+    fn the_office_signs_corners_are_selected_in_view_and_hidden_ones_are_not() {
+        let w = hallway();
+        let pose = [8.0, 0.0, 0.3];
+        let v = select(&w, pose, [640, 480], 16.0, 12.0, 0.15);
+        assert!(!v.is_empty());
+        // The red sign (x 12.2–12.6, z 1.4–1.7 on the north wall) is a strong vertex source.
+        let sign: Vec<&Vertex> =
+            v.iter().filter(|x| (12.1..12.7).contains(&x.point_m[0]) && x.point_m[1] > 0.9).collect();
+        assert_eq!(sign.len(), 4, "{v:#?}");
+        for x in &v {
+            assert!(
+                (16.0..=624.0).contains(&x.image_px[0]) && (16.0..=464.0).contains(&x.image_px[1]),
+                "{x:?}"
+            );
+            assert!(x.contrast.abs() >= 0.15);
+        }
+        assert!(v.windows(2).all(|p| p[0].contrast.abs() >= p[1].contrast.abs()));
+        // Looking the other way, the sign is behind the camera: not selected.
+        let back = select(&w, [8.0, 0.0, std::f64::consts::PI], [640, 480], 16.0, 12.0, 0.15);
+        assert!(back.iter().all(|x| x.point_m[0] < 8.0), "{back:#?}");
+    }
+}
