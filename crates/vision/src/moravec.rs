@@ -93,6 +93,12 @@ impl Moravec {
             row[ww - m..].fill(0);
         }
         #[cfg(target_arch = "x86_64")]
+        if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512bw") {
+            // SAFETY: the CPU has AVX-512 F and BW.
+            unsafe { interest_avx512(img, w, p.window, &mut self.bufs, &mut self.interest) };
+            return Ok(&self.interest);
+        }
+        #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2.
             unsafe { interest_avx2(img, w, p.window, &mut self.bufs, &mut self.interest) };
@@ -123,6 +129,16 @@ impl Moravec {
                     if v < threshold {
                         continue;
                     }
+                    // Most candidates are on the slope of a peak: a larger neighbour next door
+                    // rules them out before the whole neighbourhood is read.
+                    let next_door = |j: usize, i: usize| map[j * ww + i] > v;
+                    if (x > 0 && next_door(y, x - 1))
+                        || (x + 1 < ww && next_door(y, x + 1))
+                        || (y > 0 && next_door(y - 1, x))
+                        || (y + 1 < wh && next_door(y + 1, x))
+                    {
+                        continue;
+                    }
                     let (xs, xe) = (x.saturating_sub(r), (x + r).min(ww - 1));
                     let peak = (ys..=ye).all(|j| {
                         let nb = &map[j * ww + xs..=j * ww + xe];
@@ -148,6 +164,12 @@ impl Moravec {
         self.corners.truncate(p.max_corners);
         self.corners.sort_unstable_by(order); // a total order: unstable is deterministic, and allocates nothing
     }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw")]
+unsafe fn interest_avx512(img: &Gray<'_>, w: Rect, k: usize, bufs: &mut Buffers, out: &mut [u32]) {
+    interest(img, w, k, bufs, out)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -255,22 +277,33 @@ fn interest(img: &Gray<'_>, w: Rect, k: usize, bufs: &mut Buffers, out: &mut [u3
     // Output row `y` is the window's centre row: rows `y - h ..= y + h`.
     for y in top + h..wh - 1 - h {
         let dst = &mut out[y * ww + cx0 + h..y * ww + cx0 + h + m];
-        for (d, &shift) in SHIFTS.iter().enumerate() {
-            let c = &mut cols[d * m..(d + 1) * m];
-            if y > top + h {
-                let (enter, leave) = (slot(d, y + h), slot(d, y - h - 1));
-                row_sums(img, w.y0 + y + h, w.x0 + cx0, shift, k, diffs, &mut ring[enter..enter + m]);
-                let (new, old) = (&ring[enter..enter + m], &ring[leave..leave + m]);
-                for ((c, &a), &b) in c.iter_mut().zip(new).zip(old) {
-                    *c = c.wrapping_add(a).wrapping_sub(b);
-                }
+        let (c0, rest) = cols.split_at_mut(m);
+        let (c1, rest) = rest.split_at_mut(m);
+        let (c2, c3) = rest.split_at_mut(m);
+        if y == top + h {
+            for ((((o, &a), &b), &c), &e) in dst.iter_mut().zip(&*c0).zip(&*c1).zip(&*c2).zip(&*c3) {
+                *o = a.min(b).min(c).min(e);
             }
+            continue;
         }
-        let (c0, rest) = cols.split_at(m);
-        let (c1, rest) = rest.split_at(m);
-        let (c2, c3) = rest.split_at(m);
-        for ((((o, &a), &b), &c), &e) in dst.iter_mut().zip(c0).zip(c1).zip(c2).zip(c3) {
-            *o = a.min(b).min(c).min(e);
+        for (d, &shift) in SHIFTS.iter().enumerate() {
+            let enter = slot(d, y + h);
+            row_sums(img, w.y0 + y + h, w.x0 + cx0, shift, k, diffs, &mut ring[enter..enter + m]);
+        }
+        // One pass: each shift's column sums gain the entering row and lose the leaving one,
+        // and the interest is their minimum.
+        let rows = |d: usize| {
+            let (e, l) = (slot(d, y + h), slot(d, y - h - 1));
+            (&ring[e..e + m], &ring[l..l + m])
+        };
+        let ((n0, o0), (n1, o1), (n2, o2), (n3, o3)) = (rows(0), rows(1), rows(2), rows(3));
+        for x in 0..m {
+            let a = c0[x].wrapping_add(n0[x]).wrapping_sub(o0[x]);
+            let b = c1[x].wrapping_add(n1[x]).wrapping_sub(o1[x]);
+            let c = c2[x].wrapping_add(n2[x]).wrapping_sub(o2[x]);
+            let e = c3[x].wrapping_add(n3[x]).wrapping_sub(o3[x]);
+            (c0[x], c1[x], c2[x], c3[x]) = (a, b, c, e);
+            dst[x] = a.min(b).min(c).min(e);
         }
     }
 }
