@@ -38,6 +38,9 @@ struct Args {
     /// between these orientations (degrees, `LO,HI`), published on `vision/requests` as id 1.
     #[arg(long, value_delimiter = ',')]
     lines: Option<Vec<f32>>,
+    /// The window of the `--lines` request, `U0,V0,U1,V1` pixels (default: the whole frame).
+    #[arg(long, value_delimiter = ',')]
+    lines_window: Option<Vec<f32>>,
 }
 
 /// `K/N` with `K < N`.
@@ -78,6 +81,10 @@ fn main() -> anyhow::Result<()> {
             ..Default::default()
         };
         own.params[4..6].copy_from_slice(range);
+        if let Some(win) = &args.lines_window {
+            anyhow::ensure!(win.len() == 4, "--lines-window takes U0,V0,U1,V1; got {win:?}");
+            own.window_px.copy_from_slice(win);
+        }
         // Published so the recording shows what was asked; answered like any other.
         request_pub.send(&own)?;
         asked.insert(own.request_id, own);
