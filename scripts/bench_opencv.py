@@ -43,7 +43,7 @@ def rect(text):
 def opencv_case(kernel, img, win, tmpl):
     x0, y0, x1, y1 = win
     sub = np.ascontiguousarray(img[y0:y1, x0:x1])
-    if kernel.startswith("normalised correlation"):
+    if kernel.startswith("normalised correlation") or kernel.startswith("coarse-to-fine"):
         tx0, ty0, tx1, ty1 = tmpl
         t = np.ascontiguousarray(img[ty0:ty1, tx0:tx1])
         return "matchTemplate TM_CCORR_NORMED + minMaxLoc", lambda: cv2.minMaxLoc(

@@ -17,6 +17,7 @@ use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
+use harvey_vision::pyramid::{Pyramid, coarse_to_fine};
 use harvey_vision::{Gray, GrayBuf, Rect};
 
 /// Median microseconds per call of `f`, over enough calls to fill about 0.3 s.
@@ -194,6 +195,35 @@ fn bench_frs(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     }
 }
 
+/// Coarse-to-fine (3 levels, pyramid built per frame) against the exhaustive search of the
+/// same 32x32 template at full resolution.
+fn bench_coarse_to_fine(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
+    let tr = textured(img, 32);
+    let t = GrayBuf::crop(img, tr).expect("template");
+    let (mut pi, mut pt, mut c) = (Pyramid::default(), Pyramid::default(), Correlator::default());
+    pt.build(&t.view(), 3).expect("template pyramid");
+    let tmpl = Template::new(&t).expect("template");
+    for (scope, win) in
+        [("full frame".to_owned(), img.full()), ("96x96 window".to_owned(), around(img, tr, 96))]
+    {
+        pi.build(img, 3).expect("pyramid");
+        let m = coarse_to_fine(&pi, &pt, win, 2, &mut c).expect("found");
+        assert_eq!((m.x, m.y), (tr.x0, tr.y0), "found where it was cut, {scope}");
+        let kernel = "coarse-to-fine correlation 32x32 (vs exhaustive)";
+        let mut exhaustive = Correlator::default();
+        rows.push(measure(
+            Row::new(kernel, size, scope, win, tr),
+            || {
+                pi.build(img, 3).expect("pyramid");
+                black_box(coarse_to_fine(&pi, &pt, win, 2, &mut c).expect("found"));
+            },
+            || {
+                black_box(exhaustive.best(img, win, &tmpl).expect("found"));
+            },
+        ));
+    }
+}
+
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let world = harvey_world::World::load(&root.join("worlds/hallway.toml")).expect("world");
@@ -208,6 +238,7 @@ fn main() {
         bench_moravec(&img.view(), &size, &mut rows);
         bench_flf(&img.view(), &size, &mut rows);
         bench_frs(&img.view(), &size, &mut rows);
+        bench_coarse_to_fine(&img.view(), &size, &mut rows);
     }
     println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
     println!("|---|---|---|---:|---:|---:|");
