@@ -37,6 +37,10 @@ enum Cmd {
         /// Report the first message that differs, and exit 1 if any does.
         #[arg(long)]
         check: bool,
+        /// Also draw the replay into a Rerun file as the recording did (slower; `harvey export`
+        /// draws one afterwards).
+        #[arg(long)]
+        rrd: bool,
         #[command(flatten)]
         opts: LaunchArgs,
     },
@@ -130,12 +134,12 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             println!("launch: {outcome:?}");
             Ok(outcome.exit_code())
         }
-        Cmd::Replay { recording, check, opts } => {
+        Cmd::Replay { recording, check, rrd, opts } => {
             let run_dir = opts
                 .run_dir
                 .clone()
                 .unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
-            let file = replay::prepare(&recording, &run_dir)?;
+            let file = replay::prepare(&recording, &run_dir, rrd)?;
             let (outcome, _) = launch_file(&file, &LaunchArgs { run_dir: Some(run_dir.clone()), ..opts })?;
             println!("replay: {outcome:?}");
             let again = run_dir.join("run.mcap");

@@ -13,7 +13,7 @@ use harvey_replayer::INPUT_SERVICES;
 pub const LAUNCH_FILE: &str = "replay.toml";
 
 /// Writes the replay's launch and world files into `run_dir`; returns the launch file's path.
-pub fn prepare(recording: &Path, run_dir: &Path) -> anyhow::Result<PathBuf> {
+pub fn prepare(recording: &Path, run_dir: &Path, rrd: bool) -> anyhow::Result<PathBuf> {
     let name = recording.display().to_string();
     let bytes = std::fs::read(recording).with_context(|| format!("reading {name}"))?;
     let summary = mcap::Summary::read(&bytes)
@@ -35,14 +35,17 @@ pub fn prepare(recording: &Path, run_dir: &Path) -> anyhow::Result<PathBuf> {
     let output = std::fs::canonicalize(run_dir)?.join("run.mcap");
     anyhow::ensure!(output != original, "the replay would overwrite {name}: choose another --run-dir");
     std::fs::write(run_dir.join("world.toml"), world)?;
-    let text = replay_launch(&launch, &original).with_context(|| format!("{name}: attached launch file"))?;
+    let text =
+        replay_launch(&launch, &original, rrd).with_context(|| format!("{name}: attached launch file"))?;
     let path = run_dir.join(LAUNCH_FILE);
     std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
     Ok(path)
 }
 
-/// The launch file of a replay of `recording`, from the launch file that recorded it.
-pub fn replay_launch(text: &str, recording: &Path) -> anyhow::Result<String> {
+/// The launch file of a replay of `recording`, from the launch file that recorded it. Without
+/// `rrd`, services lose their `--rrd FILE` arguments: a replay checks and records the MCAP, and
+/// `harvey export` draws it when wanted.
+pub fn replay_launch(text: &str, recording: &Path, rrd: bool) -> anyhow::Result<String> {
     let mut doc: toml::Table = text.parse()?;
     let launch = doc.get_mut("launch").and_then(|l| l.as_table_mut()).context("no [launch] table")?;
     let name = launch.get("name").and_then(|n| n.as_str()).unwrap_or("run").to_owned();
@@ -60,6 +63,16 @@ pub fn replay_launch(text: &str, recording: &Path) -> anyhow::Result<String> {
     let at =
         services.iter().position(is_input).context("no input service (simulated DRV, bridge, camera)")?;
     services.retain(|s| !is_input(s));
+    if !rrd {
+        for s in services.iter_mut() {
+            if let Some(args) = s.get_mut("args").and_then(|a| a.as_array_mut())
+                && let Some(i) = args.iter().position(|a| a.as_str() == Some("--rrd"))
+                && i + 1 < args.len()
+            {
+                args.drain(i..i + 2);
+            }
+        }
+    }
     let mut replayer = toml::Table::new();
     replayer.insert("name".into(), "replayer".into());
     replayer.insert("args".into(), vec!["--recording".to_owned(), recording.display().to_string()].into());
@@ -75,7 +88,7 @@ mod tests {
     #[test]
     fn the_input_services_give_way_to_the_replayer() {
         let text = std::fs::read_to_string("missions/default.toml").expect("default mission");
-        let out = replay_launch(&text, Path::new("/r/run.mcap")).expect("rewrites");
+        let out = replay_launch(&text, Path::new("/r/run.mcap"), false).expect("rewrites");
         let lf =
             crate::launch::LaunchFile::parse(&out, Path::new("replay.toml")).expect("a valid launch file");
         let names: Vec<&str> = lf.services.iter().map(|s| s.name()).collect();
@@ -87,8 +100,12 @@ mod tests {
         assert_eq!(lf.clock_chain().last().map(String::as_str), Some("recorder"));
         assert_eq!(lf.services[1].args, ["--recording", "/r/run.mcap"]);
         assert!(out.contains("[mission]") && out.contains("move_m = 4.0"), "the mission travels along");
+        assert!(!lf.services[0].args.iter().any(|a| a == "--rrd"), "no Rerun file unless asked");
+        let with_rrd = replay_launch(&text, Path::new("/r/run.mcap"), true).expect("rewrites");
+        assert!(with_rrd.contains("--rrd"));
         assert!(
-            replay_launch("[launch]\nname = \"x\"\n[[service]]\nname = \"ums\"\n", Path::new("r")).is_err()
+            replay_launch("[launch]\nname = \"x\"\n[[service]]\nname = \"ums\"\n", Path::new("r"), false)
+                .is_err()
         );
     }
 }

@@ -222,7 +222,7 @@ fn label_rows(img: &Gray<'_>, w: Rect, strong: i32, lut: &[u8], labels: &mut [u8
         }
         let mut x = 0;
         while x < ww {
-            if x + 8 <= ww && out[x..x + 8].iter().all(|&v| v == 0) {
+            if x + 8 <= ww && crate::regions::zero8(&out[x..x + 8]) {
                 x += 8;
                 continue;
             }

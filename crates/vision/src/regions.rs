@@ -46,7 +46,7 @@ impl Runs {
             let mut x = 0;
             while x < w {
                 // Background (label 0) is the rule: skip it eight bytes at a time.
-                if x + 8 <= w && row[x..x + 8].iter().all(|&v| v == 0) {
+                if x + 8 <= w && zero8(&row[x..x + 8]) {
                     x += 8;
                     continue;
                 }
@@ -243,4 +243,12 @@ pub fn cell_gradient(img: &Gray<'_>, x: usize, y: usize) -> f32 {
     let (c, d) = (f32::from(img.at(x, y + 1)), f32::from(img.at(x + 1, y + 1)));
     let (gx, gy) = ((b + d - a - c) / 2.0, (c + d - a - b) / 2.0);
     (gx * gx + gy * gy).sqrt()
+}
+
+/// Whether eight bytes are all zero, read as one word.
+#[inline(always)]
+pub(crate) fn zero8(b: &[u8]) -> bool {
+    let mut w = [0u8; 8];
+    w.copy_from_slice(&b[..8]);
+    u64::from_ne_bytes(w) == 0
 }

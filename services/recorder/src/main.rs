@@ -21,6 +21,11 @@ mod writer;
 use taps::{Batch, FrameTap, Intake, MsgTap, Tap};
 use writer::{Files, Writer};
 
+/// Ticks of messages the bus thread gathers before handing them to the writer thread.
+const TICKS_PER_BATCH: usize = 8;
+/// …or sooner, once they hold this many bytes.
+const BATCH_BYTES: usize = 8 << 20;
+
 #[derive(Parser)]
 #[command(about = "Record every topic to an MCAP file")]
 struct Args {
@@ -100,14 +105,16 @@ fn main() -> anyhow::Result<()> {
 
     let mut intake = Intake { batch: Batch::default(), spare: Vec::new(), until_ns: u64::MAX, left_out: 0 };
     let mut last_turn: Option<Instant> = None;
+    let (mut turns_held, mut last_send) = (0usize, Instant::now());
     loop {
         let step = pace.next(&waiter, Some(flush_every))?;
         if let Step::Go(Some(tick)) = step {
             intake.until_ns = tick;
             // Wall time the whole chain took for this tick: the loop latency plot.
             let now = Instant::now();
-            intake.batch.loop_latency =
-                last_turn.map(|at| (tick, now.duration_since(at).as_secs_f64() * 1e3));
+            if let Some(at) = last_turn {
+                intake.batch.loop_latency.push((tick, now.duration_since(at).as_secs_f64() * 1e3));
+            }
             last_turn = Some(now);
         }
         while let Some(b) = writer.returned() {
@@ -122,8 +129,17 @@ fn main() -> anyhow::Result<()> {
         // The tick's messages are out of shared memory: the chain may go on while they are
         // written.
         pace.done()?;
-        if !intake.batch.items.is_empty() || intake.batch.loop_latency.is_some() {
+        // Hand over in batches of several ticks (each hand-over wakes the writer thread), but
+        // at least every half flush interval, so that a crash loses no more than it would.
+        turns_held += 1;
+        let held_bytes: usize = intake.batch.items.iter().map(|i| i.data.len()).sum();
+        let due = step == Step::Stop
+            || turns_held >= TICKS_PER_BATCH
+            || held_bytes >= BATCH_BYTES
+            || last_send.elapsed() >= flush_every / 2;
+        if due && (!intake.batch.items.is_empty() || !intake.batch.loop_latency.is_empty()) {
             writer.send(std::mem::take(&mut intake.batch))?;
+            (turns_held, last_send) = (0, Instant::now());
         }
         if step == Step::Stop {
             break;

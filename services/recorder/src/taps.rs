@@ -20,7 +20,8 @@ pub struct Item {
 #[derive(Default)]
 pub struct Batch {
     pub items: Vec<Item>,
-    pub loop_latency: Option<(u64, f64)>,
+    /// `(tick stamp, wall ms)` for each tick in the batch.
+    pub loop_latency: Vec<(u64, f64)>,
 }
 
 /// Where taps put messages: the batch, buffers to reuse, and the deterministic-mode limit.

@@ -77,8 +77,10 @@ fn write_loop(
                             .map_err(|e| anyhow::anyhow!("drawing {}: {e}", i.topic))?;
                     }
                 }
-                if let (Some((stamp, ms)), Some(rrd)) = (batch.loop_latency, files.rrd.as_mut()) {
-                    rrd.loop_latency(stamp, ms)?;
+                if let Some(rrd) = files.rrd.as_mut() {
+                    for &(stamp, ms) in &batch.loop_latency {
+                        rrd.loop_latency(stamp, ms)?;
+                    }
                 }
                 let _ = give_back.send(batch);
             }
