@@ -2,6 +2,7 @@
 //! time, checking each against odometry, and reports progress. Plan-and-monitor, perceptual
 //! servoing and FSA sequencing grow from here in their own issue.
 
+pub mod fsa;
 pub mod mission;
 
 use harvey_msgs::{CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2};
