@@ -4,6 +4,7 @@
 
 pub mod fsa;
 pub mod mission;
+pub mod schemas;
 
 use harvey_msgs::{CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2};
 use mission::{Mission, Step};
