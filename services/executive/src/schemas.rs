@@ -86,7 +86,7 @@ impl Noise {
         }
     }
 
-    pub fn next(&mut self) -> V2 {
+    pub fn vector(&mut self) -> V2 {
         if self.left == 0 {
             // splitmix64
             self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
@@ -199,11 +199,11 @@ mod tests {
     #[test]
     fn noise_is_seeded_and_persistent() {
         let (mut a, mut b) = (Noise::new(7, 0.5, 3), Noise::new(7, 0.5, 3));
-        let seq: Vec<V2> = (0..9).map(|_| a.next()).collect();
-        assert_eq!(seq, (0..9).map(|_| b.next()).collect::<Vec<_>>());
+        let seq: Vec<V2> = (0..9).map(|_| a.vector()).collect();
+        assert_eq!(seq, (0..9).map(|_| b.vector()).collect::<Vec<_>>());
         assert!(seq[0] == seq[2] && seq[2] != seq[3], "held for 3 steps");
         assert!(seq.iter().all(|v| (v.norm() - 0.5).abs() < 1e-12));
-        assert_ne!(seq, (0..9).map(|_| Noise::new(8, 0.5, 3).next()).collect::<Vec<_>>());
+        assert_ne!(seq, (0..9).map(|_| Noise::new(8, 0.5, 3).vector()).collect::<Vec<_>>());
     }
 
     #[test]
@@ -228,7 +228,7 @@ mod tests {
                 &[
                     move_to_goal(at, goal, 1.0),
                     avoid_obstacle(at, obstacle, 0.4, 1.0, 1.5, 100.0),
-                    noise.next(),
+                    noise.vector(),
                 ],
                 1.0,
             );
