@@ -5,6 +5,7 @@
 pub mod fsa;
 pub mod mission;
 pub mod schemas;
+pub mod servo;
 
 use harvey_msgs::{CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2};
 use mission::{Mission, Step};
