@@ -113,6 +113,20 @@ fn the_reference_recording_replays_exactly() {
     .expect("runs");
     assert_eq!(clash.status.code(), Some(2));
     assert!(text(&clash).contains("would overwrite"), "{}", text(&clash));
+    // A cut recording is refused with the file named, before anything starts.
+    let cut = dir.join("cut.mcap");
+    std::fs::write(&cut, &bytes[..bytes.len() / 3]).expect("written");
+    let out =
+        common::harvey(&["replay", cut.to_str().expect("utf8"), "--prefix", &prefix]).output().expect("runs");
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(
+        text(&out).contains(&format!("harvey: error: {}: no readable summary", cut.display())),
+        "{}",
+        text(&out)
+    );
+    let diff_out = diff(&cut, &reference);
+    assert_eq!(diff_out.status.code(), Some(2), "{}", text(&diff_out));
+    assert!(text(&diff_out).contains("ended in the middle of a record"), "{}", text(&diff_out));
 }
 
 #[test]
