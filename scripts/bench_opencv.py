@@ -68,6 +68,21 @@ def opencv_case(kernel, img, win, tmpl):
             return [cv2.connectedComponentsWithStats((classes == c).astype(np.uint8), connectivity=8)
                     for c in (1, 2, 3)]
         return "LUT + connectedComponentsWithStats per class", regions
+    if kernel.startswith("activity"):
+        frames = [sub, np.ascontiguousarray(np.roll(sub, -1, axis=1))]
+
+        def motion():
+            acc = np.zeros(sub.shape, np.float32)
+            for a, b in zip(frames + frames, (frames + frames)[1:4]):
+                cv2.accumulate(cv2.absdiff(a, b), acc)
+            return cv2.moments(acc)
+        return "absdiff + accumulate (3 pairs) + moments", motion
+    if kernel.startswith("phototropic"):
+        def bright():
+            _, peak, _, _ = cv2.minMaxLoc(sub)
+            _, mask = cv2.threshold(sub, peak - 21, 255, cv2.THRESH_BINARY)
+            return cv2.connectedComponentsWithStats(mask, connectivity=8)
+        return "minMaxLoc + threshold + connectedComponentsWithStats", bright
     raise ValueError(kernel)
 
 

@@ -13,6 +13,7 @@ use std::time::Instant;
 
 use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
+use harvey_vision::cues::{ActivityDetector, ActivityVote, brightest};
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::moravec::{Moravec, MoravecParams};
@@ -224,6 +225,43 @@ fn bench_coarse_to_fine(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     }
 }
 
+/// Activity detection (absolute differences, 4 frames) and phototropic perception.
+fn bench_cues(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
+    // A second view: the frame one pixel to the left, so that every edge moves.
+    let moved = GrayBuf::from_fn(img.width, img.height, |x, y| img.at((x + 1).min(img.width - 1), y));
+    let views = [*img, moved.view()];
+    let win = around(img, textured(img, 16), 96);
+    for (scope, win) in [("full frame".to_owned(), img.full()), ("96x96 window".to_owned(), win)] {
+        let mut det = ActivityDetector::new(ActivityVote::Difference, 4);
+        let mut kept = Vec::new();
+        let mut k = 0usize;
+        let mut k2 = 0usize;
+        rows.push(measure(
+            Row::new("activity detection, 4 frames", size, scope.clone(), win, Rect::default()),
+            || {
+                k += 1;
+                black_box(det.push(&views[k % 2], win).expect("runs"));
+            },
+            || {
+                k2 += 1;
+                black_box(reference::activity(&mut kept, &views[k2 % 2], win, 4));
+            },
+        ));
+        let mut frs = Frs::default();
+        let ours = brightest(&mut frs, img, win, 20, 1).expect("runs").map_or(0, |r| r.area as usize);
+        assert_eq!(ours, reference::brightest(img, win, 20), "brightest region in {scope}");
+        rows.push(measure(
+            Row::new("phototropic (brightest region)", size, scope, win, Rect::default()),
+            || {
+                black_box(brightest(&mut frs, img, win, 20, 1).expect("runs"));
+            },
+            || {
+                black_box(reference::brightest(img, win, 20));
+            },
+        ));
+    }
+}
+
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let world = harvey_world::World::load(&root.join("worlds/hallway.toml")).expect("world");
@@ -239,6 +277,7 @@ fn main() {
         bench_flf(&img.view(), &size, &mut rows);
         bench_frs(&img.view(), &size, &mut rows);
         bench_coarse_to_fine(&img.view(), &size, &mut rows);
+        bench_cues(&img.view(), &size, &mut rows);
     }
     println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
     println!("|---|---|---|---:|---:|---:|");

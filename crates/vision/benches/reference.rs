@@ -188,3 +188,53 @@ fn root(p: &mut [usize], mut i: usize) -> usize {
     }
     i
 }
+
+/// Activity detection the plain way: the last `depth` windows kept as fresh copies, the motion
+/// plane recomputed from all pairs, its centroid. Returns the centroid.
+pub fn activity(frames: &mut Vec<Vec<u8>>, img: &Gray<'_>, win: Rect, depth: usize) -> [f64; 2] {
+    let mut copy = Vec::new();
+    for y in win.y0..win.y1 {
+        for x in win.x0..win.x1 {
+            copy.push(img.at(x, y));
+        }
+    }
+    frames.push(copy);
+    if frames.len() > depth {
+        frames.remove(0);
+    }
+    let w = win.width();
+    let (mut sum, mut sx, mut sy) = (0.0, 0.0, 0.0);
+    for i in 0..frames[0].len() {
+        let mut v = 0.0;
+        for k in 1..frames.len() {
+            v += f64::from(frames[k][i].abs_diff(frames[k - 1][i]));
+        }
+        sum += v;
+        sx += v * ((i % w) as f64 + 0.5);
+        sy += v * ((i / w) as f64 + 0.5);
+    }
+    [sx / sum.max(1e-9), sy / sum.max(1e-9)]
+}
+
+/// The brightest region the plain way: the window's maximum, every pixel within `margin` of it
+/// marked, pixel-by-pixel union-find, the largest component. Returns its area.
+pub fn brightest(img: &Gray<'_>, win: Rect, margin: u8) -> usize {
+    let (w, h) = (win.width(), win.height());
+    let peak = (win.y0..win.y1)
+        .flat_map(|y| (win.x0..win.x1).map(move |x| (x, y)))
+        .map(|(x, y)| img.at(x, y))
+        .max()
+        .unwrap_or(0);
+    let class: Vec<u8> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .map(|(x, y)| u8::from(img.at(win.x0 + x, win.y0 + y) >= peak.saturating_sub(margin)))
+        .collect();
+    let mut parent = label_regions(&class, w, h);
+    let mut area = std::collections::HashMap::<usize, usize>::new();
+    for (i, &c) in class.iter().enumerate() {
+        if c != 0 {
+            *area.entry(root(&mut parent, i)).or_default() += 1;
+        }
+    }
+    area.values().copied().max().unwrap_or(0)
+}
