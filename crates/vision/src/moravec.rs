@@ -60,6 +60,11 @@ impl Moravec {
         Ok(&self.corners)
     }
 
+    /// The corners the last call to [`Moravec::corners`] found.
+    pub fn last_corners(&self) -> &[Corner] {
+        &self.corners
+    }
+
     /// The interest of every pixel of `window` (0 where the window does not fit), row-major.
     pub fn interest_map(
         &mut self,

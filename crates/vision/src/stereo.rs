@@ -5,7 +5,7 @@
 
 use crate::GrayBuf;
 use crate::image::{Gray, Rect, VisionError};
-use crate::moravec::{Moravec, MoravecParams};
+use crate::moravec::{Corner, Moravec, MoravecParams};
 use crate::nc::{Correlator, Template};
 
 /// The rig and the search.
@@ -69,9 +69,8 @@ impl Stereo {
         let (d_min, d_max) = (fb / p.far_m, fb / p.near_m);
         let half = p.patch / 2;
         self.matches.clear();
-        let corners: Vec<(usize, usize)> =
-            self.moravec.corners(left, window, &p.moravec)?.iter().map(|c| (c.x, c.y)).collect();
-        for (x, y) in corners {
+        self.moravec.corners(left, window, &p.moravec)?;
+        for &Corner { x, y, .. } in self.moravec.last_corners() {
             if x < half
                 || y < half + p.band_rows
                 || y + half + p.band_rows >= left.height

@@ -132,10 +132,9 @@ fn main() -> anyhow::Result<()> {
         // Hand over in batches of several ticks (each hand-over wakes the writer thread), but
         // at least every half flush interval, so that a crash loses no more than it would.
         turns_held += 1;
-        let held_bytes: usize = intake.batch.items.iter().map(|i| i.data.len()).sum();
         let due = step == Step::Stop
             || turns_held >= TICKS_PER_BATCH
-            || held_bytes >= BATCH_BYTES
+            || intake.batch.bytes >= BATCH_BYTES
             || last_send.elapsed() >= flush_every / 2;
         if due && (!intake.batch.items.is_empty() || !intake.batch.loop_latency.is_empty()) {
             writer.send(std::mem::take(&mut intake.batch))?;

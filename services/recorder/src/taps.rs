@@ -22,6 +22,8 @@ pub struct Batch {
     pub items: Vec<Item>,
     /// `(tick stamp, wall ms)` for each tick in the batch.
     pub loop_latency: Vec<(u64, f64)>,
+    /// Payload bytes held.
+    pub bytes: usize,
 }
 
 /// Where taps put messages: the batch, buffers to reuse, and the deterministic-mode limit.
@@ -59,6 +61,7 @@ impl Intake {
         fill: impl FnOnce(Vec<u8>) -> Vec<u8>,
     ) {
         let data = fill(self.buffer(bytes));
+        self.batch.bytes += data.len();
         self.batch.items.push(Item { channel, topic, seq, stamp_ns, data });
     }
 
