@@ -5,7 +5,11 @@
 //!
 //! `taskset -c 0 cargo bench -p harvey-vision --bench kernels`
 
+mod geometry;
 mod reference;
+mod reference_geometry;
+#[path = "../tests/common/sidewalk.rs"]
+mod sidewalk;
 
 use std::hint::black_box;
 use std::path::Path;
@@ -61,11 +65,15 @@ fn measure(mut row: Row, harvey: impl FnMut(), reference: impl FnMut()) -> Row {
     row
 }
 
+/// Looking down the hallway from its start: door jambs, tiles, signs.
 fn frame(world: &harvey_world::World, w: u32, h: u32) -> GrayBuf {
+    frame_at(world, w, h, geometry::POSE)
+}
+
+fn frame_at(world: &harvey_world::World, w: u32, h: u32, pose: [f64; 3]) -> GrayBuf {
     let mut r = Renderer::new(world, w, h, Encoding::Mono8);
     let mut px = vec![0u8; r.frame_bytes()];
-    // Looking down the hallway from its start: door jambs, tiles, signs.
-    r.render(world, [0.5, -0.3, 0.05], &mut px).expect("renders");
+    r.render(world, pose, &mut px).expect("renders");
     GrayBuf { width: w as usize, height: h as usize, data: px }
 }
 
@@ -278,6 +286,10 @@ fn main() {
         bench_frs(&img.view(), &size, &mut rows);
         bench_coarse_to_fine(&img.view(), &size, &mut rows);
         bench_cues(&img.view(), &size, &mut rows);
+        geometry::bench_stereo(&world, &img, &size, &mut rows);
+        geometry::bench_depth(&world, &img, &size, &mut rows);
+        geometry::bench_hough(&img, &size, &mut rows);
+        geometry::bench_path(w as usize, h as usize, &size, &mut rows);
     }
     println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
     println!("|---|---|---|---:|---:|---:|");

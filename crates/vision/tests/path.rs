@@ -3,32 +3,12 @@
 //! from a bootstrap prediction 10 px and 3 degrees off; with an edge hidden, the path is lost
 //! (confidence too low even with widened tolerances) and the last model is kept.
 
-use harvey_vision::GrayBuf;
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::path::{ImageLine, PathParams, PathTracker};
 
-/// A bright path between dark verges, edges from the vanishing point `(vx, 200)` to `xl` and
-/// `xr` on the bottom row, anti-aliased; `hide_right` paints the right verge over the path.
-fn path(vx: f32, xl: f32, xr: f32, hide_right: bool) -> GrayBuf {
-    let (vy, bottom) = (200.0f32, 480.0f32);
-    let inside = |x: f32, y: f32| {
-        if y <= vy {
-            return false;
-        }
-        let t = (y - vy) / (bottom - vy);
-        let (l, r) = (vx + t * (xl - vx), vx + t * (xr - vx));
-        x > l && (x < r || hide_right)
-    };
-    GrayBuf::from_fn(640, 480, |x, y| {
-        let n = (0..16)
-            .filter(|k| {
-                inside(x as f32 + (k % 4) as f32 / 4.0 + 0.125, y as f32 + (k / 4) as f32 / 4.0 + 0.125)
-            })
-            .count();
-        let texture = (x * 7 + y * 13) % 5;
-        (50 + texture + n * 130 / 16) as u8
-    })
-}
+#[path = "common/sidewalk.rs"]
+mod sidewalk;
+use sidewalk::path;
 
 fn truth(vx: f32, xb: f32) -> ImageLine {
     ImageLine::through([vx, 200.0], [xb, 480.0])

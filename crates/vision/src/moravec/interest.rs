@@ -1,0 +1,153 @@
+//! The Moravec interest rows: for each of the four shifts the squared differences are summed
+//! down a `k`-row column (a sliding sum: the row entering the window is added and the row
+//! leaving it taken away, both recomputed from the image), then across `k` columns; the interest
+//! is the smallest of the four. Rows stream out one at a time to a [`RowSink`], so the whole
+//! pass runs in the first-level cache.
+
+use crate::image::{Gray, Rect};
+
+/// The four shifts: right, down, and the two diagonals.
+pub(super) const SHIFTS: [(isize, isize); 4] = [(1, 0), (0, 1), (1, 1), (1, -1)];
+
+/// Where interest rows go: the row buffer for row `y` (the window's full width), then word that
+/// it is filled.
+pub(super) trait RowSink {
+    fn row(&mut self, y: usize) -> &mut [u32];
+    fn done(&mut self, y: usize);
+}
+
+/// Scratch: one column sum per shift and column.
+#[derive(Debug, Default)]
+pub(super) struct Columns {
+    sums: Vec<u32>,
+}
+
+/// The margin (pixels) of a `k x k` window where the interest is not defined (it is 0 there):
+/// the shifted window must stay inside.
+pub(super) fn margin(k: usize) -> usize {
+    k / 2 + 1
+}
+
+/// Streams every row of `w` (0 in the margins) to `sink`, top to bottom.
+pub(super) fn interest_rows(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512bw") {
+        // SAFETY: the CPU has AVX-512 F and BW.
+        return unsafe { rows_avx512(img, w, k, cols, sink) };
+    }
+    #[cfg(target_arch = "x86_64")]
+    if std::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2.
+        return unsafe { rows_avx2(img, w, k, cols, sink) };
+    }
+    rows(img, w, k, cols, sink)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512bw")]
+unsafe fn rows_avx512(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
+    rows(img, w, k, cols, sink)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn rows_avx2(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
+    rows(img, w, k, cols, sink)
+}
+
+/// `(p - q)²`: at most 255², which fits 16 bits, so it is formed in 16-bit lanes.
+#[inline(always)]
+fn sq(p: u8, q: u8) -> u32 {
+    let d = i16::from(p) - i16::from(q);
+    u32::from(d.wrapping_mul(d) as u16)
+}
+
+/// Image row `y` and the same row shifted by `(dx, dy)`, columns `x0 .. x0 + n`.
+#[inline(always)]
+fn pair<'a>(img: &Gray<'a>, y: usize, x0: usize, n: usize, (dx, dy): (isize, isize)) -> (&'a [u8], &'a [u8]) {
+    let a = &img.row(y)[x0..x0 + n];
+    let b = &img.row(y.wrapping_add_signed(dy))[x0.wrapping_add_signed(dx)..][..n];
+    (a, b)
+}
+
+#[inline(always)]
+fn rows(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
+    let (ww, wh, h, mg) = (w.width(), w.height(), k / 2, margin(k));
+    if ww <= 2 * mg || wh <= 2 * mg {
+        for y in 0..wh {
+            sink.row(y).fill(0);
+            sink.done(y);
+        }
+        return;
+    }
+    // Columns whose shifted pixels stay inside: 1 .. ww - 1; centres: mg .. ww - mg.
+    let (x0, n) = (w.x0 + 1, ww - 2);
+    let m = n - 2 * h;
+    cols.sums.clear();
+    cols.sums.resize(SHIFTS.len() * n, 0);
+    let top = 1; // the first row a window covers (row 0 is read by the up-right shift)
+    for y in 0..mg {
+        sink.row(y).fill(0);
+        sink.done(y);
+    }
+    for y in mg..wh - mg {
+        let out = sink.row(y);
+        out[..mg].fill(0);
+        out[ww - mg..].fill(0);
+        let centres = &mut out[mg..mg + m];
+        for (d, &shift) in SHIFTS.iter().enumerate() {
+            let c = &mut cols.sums[d * n..(d + 1) * n];
+            if y == mg {
+                for r in top..top + k {
+                    let (a, b) = pair(img, w.y0 + r, x0, n, shift);
+                    for ((s, &p), &q) in c.iter_mut().zip(a).zip(b) {
+                        *s += sq(p, q);
+                    }
+                }
+            } else {
+                let (a, b) = pair(img, w.y0 + y + h, x0, n, shift);
+                let (e, f) = pair(img, w.y0 + y - h - 1, x0, n, shift);
+                for ((((s, &p), &q), &u), &v) in c.iter_mut().zip(a).zip(b).zip(e).zip(f) {
+                    *s = s.wrapping_add(sq(p, q)).wrapping_sub(sq(u, v));
+                }
+            }
+        }
+        match k {
+            3 => across::<3>(&cols.sums, n, centres),
+            5 => across::<5>(&cols.sums, n, centres),
+            7 => across::<7>(&cols.sums, n, centres),
+            _ => across_any(&cols.sums, n, k, centres),
+        }
+        sink.done(y);
+    }
+    for y in wh - mg..wh {
+        sink.row(y).fill(0);
+        sink.done(y);
+    }
+}
+
+/// `out[x]` = the least over the four shifts of `Σ c[x .. x + K]`, where `sums` holds the four
+/// shifts' `n` column sums one after another.
+#[inline(always)]
+fn across<const K: usize>(sums: &[u32], n: usize, out: &mut [u32]) {
+    let m = out.len();
+    let taps: [[&[u32]; K]; 4] = std::array::from_fn(|d| std::array::from_fn(|j| &sums[d * n + j..][..m]));
+    for (x, o) in out.iter_mut().enumerate() {
+        let mut best = u32::MAX;
+        for shift in &taps {
+            let mut s = 0u32;
+            for t in shift {
+                s += t[x];
+            }
+            best = best.min(s);
+        }
+        *o = best;
+    }
+}
+
+/// [`across`] for a window size without its own instance (9).
+fn across_any(sums: &[u32], n: usize, k: usize, out: &mut [u32]) {
+    for (x, o) in out.iter_mut().enumerate() {
+        *o = (0..4).map(|d| sums[d * n + x..][..k].iter().sum::<u32>()).min().unwrap_or(0);
+    }
+}
