@@ -27,7 +27,7 @@ pub enum Refusal {
 }
 
 /// The panic-stop's hold on the vehicle (001 §6.2): after an urgent stop, motion commands
-/// stamped within `hold_ns` of it are refused, so that no old or new motion command slips in
+/// stamped within `hold_ns` of it are refused (unless urgent themselves: the panic-avoid's), so that no old or new motion command slips in
 /// while the sonar keeps reporting the obstacle (it re-sends the stop with every ring).
 #[derive(Debug)]
 pub struct PanicLatch {
@@ -49,7 +49,9 @@ impl PanicLatch {
             return Ok(());
         }
         match self.until_ns {
-            Some(until_ns) if !stop && cmd.header.stamp_ns <= until_ns => {
+            // The panic-avoid's urgent motion overrides the hold (001 §6.2: the panic motor
+            // commands override any others).
+            Some(until_ns) if !stop && cmd.urgent == 0 && cmd.header.stamp_ns <= until_ns => {
                 Err(Refusal::PanicStop { id: cmd.command_id, until_ns })
             }
             _ => Ok(()),
@@ -234,6 +236,8 @@ mod tests {
             Ok(()),
             "plain stops always pass"
         );
+        let evade = MotionCommand { urgent: 1, ..cmd(CommandKind::Turn, 0.0, 1.57) };
+        assert_eq!(latch.admit(&at(evade, 1_310_000_000)), Ok(()), "the panic-avoid's urgent turn passes");
         assert_eq!(latch.admit(&at(mv, 1_400_000_000)), Ok(()), "obstacle gone: motion resumes");
     }
 

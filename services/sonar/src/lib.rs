@@ -1,5 +1,9 @@
 //! The sonar service's logic (001 §3, §6.1–6.2): assembles the 24-sensor ring from the DRV's
-//! banks of 8 and runs the panic-stop reflex, whose stop commands go straight to the vehicle.
+//! banks of 8 and runs the panic-stop reflex, whose stop commands go straight to the vehicle;
+//! the panic-avoid reflex is in `avoid.rs`.
+
+pub mod approach;
+pub mod avoid;
 
 use harvey_msgs::{CommandKind, Header, MotionCommand, SONAR_BANK_SIZE, SONAR_SENSORS, SonarRaw, SonarRing};
 

@@ -1,17 +1,34 @@
-//! harvey-sonar: raw DRV sonar banks in, the 24-sensor ring out; panic-stop commands go
-//! straight to the vehicle.
+//! harvey-sonar: raw DRV sonar banks in, the 24-sensor ring out; the panic-stop and panic-avoid
+//! reflexes' commands go straight to the vehicle (001 §6.2).
 
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::topics;
 use harvey_sonar::SonarRingBuilder;
+use harvey_sonar::avoid::{AvoidParams, PanicAvoid};
 
 #[derive(Parser)]
-#[command(about = "Sonar ring assembly and the panic-stop reflex")]
+#[command(about = "Sonar ring assembly and the panic-stop and panic-avoid reflexes")]
 struct Args {
     /// A reading ahead closer than this stops the robot (001 §6.2 gives 2 ft as its example).
     #[arg(long, default_value_t = 2.0)]
     panic_stop_ft: f64,
+    /// Panic-avoid: an object approaching head-on with less than this time to contact (s)…
+    #[arg(long, default_value_t = 4.0)]
+    avoid_ttc_s: f64,
+    /// …over this many consecutive readings ("several", 001 §6.2)…
+    #[arg(long, default_value_t = 3)]
+    avoid_confirm: u32,
+    /// …and coming at the robot at least this fast (ft/s) of its own…
+    #[arg(long, default_value_t = 0.5)]
+    avoid_min_approach_ftps: f64,
+    /// …makes it turn this far (001 §6.2: 90 degrees)…
+    #[arg(long, default_value_t = 90.0)]
+    avoid_turn_deg: f64,
+    /// …and dash this far to the side, again while the object still approaches (0: no
+    /// panic-avoid).
+    #[arg(long, default_value_t = 3.0)]
+    avoid_dash_ft: f64,
 }
 
 fn main() -> anyhow::Result<()> {
@@ -19,23 +36,48 @@ fn main() -> anyhow::Result<()> {
     let args = Args::parse();
     let bus = Bus::join("sonar")?;
     let raw = bus.subscriber(topics::DRV_SONAR_RAW)?;
+    let odometry = bus.subscriber(topics::ODOMETRY)?;
     let ring_pub = bus.publisher(topics::SONAR_RING)?;
-    let stop_pub = bus.publisher(topics::VEHICLE_COMMAND)?;
+    let command_pub = bus.publisher(topics::VEHICLE_COMMAND)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = pace.attach(&waiter, &[&raw])?;
+    let _a = pace.attach(&waiter, &[&raw, &odometry])?;
     harvey_runtime::notify_ready()?;
 
-    let mut ring = SonarRingBuilder::new(args.panic_stop_ft * 0.3048);
-    let mut banks = Vec::new();
+    const FT: f64 = 0.3048;
+    let mut ring = SonarRingBuilder::new(args.panic_stop_ft * FT);
+    let mut avoid = (args.avoid_dash_ft > 0.0).then(|| {
+        PanicAvoid::new(AvoidParams {
+            ttc_s: args.avoid_ttc_s,
+            confirm: args.avoid_confirm,
+            min_approach_mps: args.avoid_min_approach_ftps * FT,
+            arc_rad: std::f64::consts::FRAC_PI_6,
+            turn_rad: args.avoid_turn_deg.to_radians(),
+            dash_m: args.avoid_dash_ft * FT,
+        })
+    });
+    let (mut banks, mut poses) = (Vec::new(), Vec::new());
     let mut rings = 0u64;
     while pace.next(&waiter, None)? != Step::Stop {
+        odometry.drain_into(&mut poses)?;
         raw.drain_into(&mut banks)?;
+        if let Some(a) = avoid.as_mut() {
+            for o in &poses {
+                if let Some(c) = a.on_odometry(o) {
+                    tracing::warn!(command = c.command_id, kind = c.kind, "panic-avoid");
+                    command_pub.send(&c)?;
+                }
+            }
+        }
         for bank in &banks {
             match ring.on_bank(bank) {
                 Ok(update) => {
                     if let Some(stop) = update.panic_stop {
-                        stop_pub.send(&stop)?;
+                        command_pub.send(&stop)?;
+                    }
+                    if let Some(c) = avoid.as_mut().and_then(|a| a.on_ring(&update.ring)) {
+                        tracing::warn!("panic-avoid: an object is bearing down; stopping to evade");
+                        command_pub.send(&c)?;
                     }
                     ring_pub.send(&update.ring)?;
                     rings += 1;
@@ -45,6 +87,7 @@ fn main() -> anyhow::Result<()> {
         }
         pace.done()?;
     }
-    tracing::info!(rings, "sonar stopped");
+    let episodes = avoid.map_or(0, |a| a.episodes);
+    tracing::info!(rings, episodes, "sonar stopped");
     Ok(())
 }
