@@ -112,6 +112,15 @@ impl Landmark {
         let h = lo + (heading_deg - lo).rem_euclid(360.0);
         d <= self.activation_range_m && h <= hi
     }
+
+    /// The point correlation looks for (000 §5.3): a class I line's middle, else its position.
+    pub fn point(&self) -> [f64; 3] {
+        let p = self.position_m;
+        match self.class {
+            LandmarkClass::I => [p[0], p[1], p[2] + self.height_m / 2.0],
+            _ => p,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -1,13 +1,19 @@
-//! The executive's logic, first version: runs a mission's TURN/MOVE script, one primitive at a
-//! time, checking each against odometry, and reports progress. Plan-and-monitor, perceptual
-//! servoing and FSA sequencing grow from here in their own issue.
+//! The executive's logic: runs a mission's TURN/MOVE script, one primitive at a time, checking
+//! each against odometry, and reports progress. A move may be driven in increments with
+//! action-level servoing on a landmark after each (`leg.rs`, 000 §5.5). Plan-and-monitor and FSA
+//! sequencing grow from here.
 
 pub mod fsa;
+pub mod leg;
 pub mod mission;
 pub mod schemas;
 pub mod servo;
 
-use harvey_msgs::{CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2};
+use harvey_msgs::{
+    CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2, VisionAlgorithm,
+    VisionRequest, VisionResult, VisionStatus,
+};
+use leg::{Leg, LegStep, ServoSetup};
 use mission::{Mission, Step};
 
 /// What the executive wants sent.
@@ -15,16 +21,26 @@ use mission::{Mission, Step};
 pub enum Output {
     Command(MotionCommand),
     Status(MissionStatus),
+    Look(VisionRequest),
 }
+
+/// The executive's vision request ids start here (the vision workers' own standing requests
+/// use small ids).
+const REQUEST_BASE: u32 = 100;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Phase {
     /// No odometry yet: the vehicle's state is unknown.
     Waiting,
-    /// Step `i` was commanded with id `id`.
+    /// Step `i` (or an increment or correction of it) was commanded with id `id`.
     Executing {
         step: usize,
         id: u32,
+    },
+    /// Step `i` waits for the answer to vision request `request`.
+    Looking {
+        step: usize,
+        request: u32,
     },
     Done(MissionState),
 }
@@ -33,6 +49,13 @@ enum Phase {
 #[derive(Debug)]
 pub struct Executive {
     mission: Mission,
+    /// Per step, what servoing it needs (resolved from the world by the caller).
+    servo: Vec<Option<ServoSetup>>,
+    /// The incremental leg under way.
+    pub leg: Option<Leg>,
+    /// Every finished leg, for the summary.
+    pub legs: Vec<Leg>,
+    next_request: u32,
     phase: Phase,
     start_ns: u64,
     goal: Pose2,
@@ -56,9 +79,14 @@ pub fn goal_of(start: Pose2, steps: &[Step]) -> Pose2 {
 }
 
 impl Executive {
-    pub fn new(mission: Mission) -> Self {
+    /// `servo[i]` says how step `i` servos (it must say so for every `servo_landmark` step).
+    pub fn new(mission: Mission, servo: Vec<Option<ServoSetup>>) -> Self {
         Self {
             mission,
+            servo,
+            leg: None,
+            legs: Vec::new(),
+            next_request: REQUEST_BASE,
             phase: Phase::Waiting,
             start_ns: 0,
             goal: Pose2::default(),
@@ -78,28 +106,104 @@ impl Executive {
         }
     }
 
-    fn command(&mut self, step: usize, stamp_ns: u64) -> MotionCommand {
-        let s = self.mission.steps[step];
+    fn send(&mut self, step: usize, kind: CommandKind, distance_m: f64, angle_rad: f64, now: u64) -> Output {
         let id = self.next_id;
         self.next_id += 1;
         self.phase = Phase::Executing { step, id };
-        let header = Header::new(u64::from(id), stamp_ns);
-        match (s.move_m, s.turn_deg) {
-            (Some(d), _) => MotionCommand {
-                header,
-                kind: CommandKind::Move as u32,
-                distance_m: d,
-                command_id: id,
-                ..Default::default()
-            },
-            (_, a) => MotionCommand {
-                header,
-                kind: CommandKind::Turn as u32,
-                angle_rad: a.unwrap_or(0.0).to_radians(),
-                command_id: id,
-                ..Default::default()
-            },
+        Output::Command(MotionCommand {
+            header: Header::new(u64::from(id), now),
+            kind: kind as u32,
+            distance_m,
+            angle_rad,
+            command_id: id,
+            ..Default::default()
+        })
+    }
+
+    /// Starts step `step` from the pose `at`.
+    fn begin(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
+        let s: &Step = &self.mission.steps[step];
+        match (s.move_m, s.turn_deg, s.increment_m) {
+            (Some(d), _, Some(inc)) => {
+                let servo = self.servo.get(step).copied().flatten();
+                let mut leg = Leg::new(at, d, inc, servo);
+                let first = leg.start();
+                self.leg = Some(leg);
+                self.apply(step, first, at, now)
+            }
+            (Some(d), _, None) => vec![self.send(step, CommandKind::Move, d, 0.0, now)],
+            (_, a, _) => vec![self.send(step, CommandKind::Turn, 0.0, a.unwrap_or(0.0).to_radians(), now)],
         }
+    }
+
+    /// Carries out what the leg of step `step` wants next.
+    fn apply(&mut self, step: usize, next: LegStep, at: Pose2, now: u64) -> Vec<Output> {
+        match next {
+            LegStep::Move(d) => vec![self.send(step, CommandKind::Move, d, 0.0, now)],
+            LegStep::Turn(a) => {
+                if let Some(l) = &self.leg {
+                    let h = l.corrections.last().map_or(0.0, |c| c.0);
+                    tracing::info!(
+                        heading_error_deg = h.to_degrees(),
+                        turn_deg = a.to_degrees(),
+                        offset_in = l.offset_m / 0.0254,
+                        shortfall_m = l.shortfall_m,
+                        "servo correction"
+                    );
+                }
+                vec![self.send(step, CommandKind::Turn, 0.0, a, now)]
+            }
+            LegStep::Look(expected) => {
+                let (Some(s), Some(sv)) = (self.leg.as_ref().and_then(|l| l.servo), self.mission.servo)
+                else {
+                    return Vec::new();
+                };
+                let request = self.next_request;
+                self.next_request += 1;
+                self.phase = Phase::Looking { step, request };
+                let o = s.offset.map(|v| v as f32);
+                vec![Output::Look(VisionRequest {
+                    header: Header::new(u64::from(request), now),
+                    request_id: request,
+                    algorithm: VisionAlgorithm::Correlate as u32,
+                    standing: 0,
+                    landmark_index: s.landmark_index,
+                    expected,
+                    window_px: [0.0; 4],
+                    params: [sv.template_px as f32, sv.min_score as f32, o[0], o[1], o[2], 0.0, 0.0, 0.0],
+                })]
+            }
+            LegStep::Done => {
+                if let Some(l) = self.leg.take() {
+                    self.legs.push(l);
+                }
+                self.step_done(step, at, now)
+            }
+        }
+    }
+
+    /// Step `step` is over: the next one, or success.
+    fn step_done(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
+        if step + 1 < self.mission.steps.len() {
+            self.begin(step + 1, at, now)
+        } else {
+            self.phase = Phase::Done(MissionState::Succeeded);
+            Vec::new()
+        }
+    }
+
+    /// A vision result: the answer to the leg's look, if it is the one awaited.
+    pub fn on_vision(&mut self, r: &VisionResult) -> Vec<Output> {
+        let Phase::Looking { step, request } = self.phase else { return Vec::new() };
+        if r.request_id != request {
+            return Vec::new();
+        }
+        let found = (VisionStatus::from_raw(r.status) == Some(VisionStatus::Found) && r.count > 0)
+            .then(|| [f64::from(r.items[0].values[0]), f64::from(r.items[0].values[1])]);
+        let Some(leg) = self.leg.as_mut() else { return Vec::new() };
+        let next = leg.on_seen(found);
+        let (at, now) = (self.estimated, r.header.stamp_ns);
+        self.apply(step, next, at, now)
     }
 
     /// One odometry message: advance the script; returns commands and the status to publish.
@@ -111,25 +215,31 @@ impl Executive {
             Phase::Waiting => {
                 self.start_ns = now;
                 self.goal = goal_of(o.world_from_robot, &self.mission.steps);
-                out.push(Output::Command(self.command(0, now)));
+                out = self.begin(0, o.world_from_robot, now);
             }
             Phase::Executing { step, id } => {
                 let finished = o.command.command_id == id && o.command_accepted == 1 && o.moving == 0;
-                if finished && step + 1 < self.mission.steps.len() {
-                    out.push(Output::Command(self.command(step + 1, now)));
-                } else if finished {
-                    self.phase = Phase::Done(MissionState::Succeeded);
-                } else if now.saturating_sub(self.start_ns) as f64 > self.mission.timeout_s * 1e9 {
-                    self.phase = Phase::Done(MissionState::Failed);
-                    out.push(Output::Command(MotionCommand {
-                        header: Header::new(u64::from(self.next_id), now),
-                        kind: CommandKind::Stop as u32,
-                        command_id: self.next_id,
-                        ..Default::default()
-                    }));
+                if finished {
+                    out = match self.leg.as_mut() {
+                        Some(leg) => {
+                            let next = leg.on_done();
+                            self.apply(step, next, o.world_from_robot, now)
+                        }
+                        None => self.step_done(step, o.world_from_robot, now),
+                    };
                 }
             }
-            Phase::Done(_) => {}
+            Phase::Looking { .. } | Phase::Done(_) => {}
+        }
+        let running = !matches!(self.phase, Phase::Done(_));
+        if running && now.saturating_sub(self.start_ns) as f64 > self.mission.timeout_s * 1e9 {
+            self.phase = Phase::Done(MissionState::Failed);
+            out.push(Output::Command(MotionCommand {
+                header: Header::new(u64::from(self.next_id), now),
+                kind: CommandKind::Stop as u32,
+                command_id: self.next_id,
+                ..Default::default()
+            }));
         }
         out.push(Output::Status(self.status(now)));
         out
@@ -139,7 +249,7 @@ impl Executive {
         self.seq += 1;
         let step = match self.phase {
             Phase::Waiting => 0,
-            Phase::Executing { step, .. } => step,
+            Phase::Executing { step, .. } | Phase::Looking { step, .. } => step,
             Phase::Done(_) => self.mission.steps.len(),
         };
         MissionStatus {
@@ -165,9 +275,10 @@ mod tests {
         Mission {
             description: "t".into(),
             timeout_s,
+            servo: None,
             steps: vec![
-                Step { move_m: Some(2.0), turn_deg: None },
-                Step { move_m: None, turn_deg: Some(90.0) },
+                Step { move_m: Some(2.0), ..Step::default() },
+                Step { turn_deg: Some(90.0), ..Step::default() },
             ],
         }
     }
@@ -185,7 +296,7 @@ mod tests {
 
     #[test]
     fn the_script_runs_step_by_step_to_success() {
-        let mut e = Executive::new(mission(60.0));
+        let mut e = Executive::new(mission(60.0), Vec::new());
         let out = e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false));
         let Output::Command(mv) = out[0] else { panic!("{out:?}") };
         assert_eq!((mv.kind, mv.distance_m, mv.command_id), (CommandKind::Move as u32, 2.0, 1));
@@ -206,7 +317,7 @@ mod tests {
 
     #[test]
     fn a_mission_past_its_time_fails_and_stops_the_robot() {
-        let mut e = Executive::new(mission(5.0));
+        let mut e = Executive::new(mission(5.0), Vec::new());
         let out = e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false));
         let Output::Command(mv) = out[0] else { panic!("{out:?}") };
         let out = e.on_odometry(&odo(6.0, 1.0, mv, true, true));

@@ -1,14 +1,18 @@
 //! harvey-executive: runs the launch file's `[mission]`, commanding the vehicle and watching
-//! odometry, sonar, vision and the uncertainty map. Exits 0 when the mission succeeds, 3 when it
-//! fails.
+//! odometry, sonar, vision and the uncertainty map; asks the vision workers for the landmarks it
+//! servos on. Exits 0 when the mission succeeds, 3 when it fails.
 
 use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
+use harvey_executive::leg::ServoSetup;
+use harvey_executive::mission::Mission;
+use harvey_executive::servo::ServoParams;
 use harvey_executive::{Executive, Output, mission};
 use harvey_msgs::{MissionState, topics};
+use harvey_world::World;
 
 #[derive(Parser)]
 #[command(about = "Mission executive")]
@@ -16,6 +20,43 @@ struct Args {
     /// The launch file holding the `[mission]` table.
     #[arg(long)]
     mission: PathBuf,
+    /// The world file (needed by missions that servo on landmarks).
+    #[arg(long)]
+    world: Option<PathBuf>,
+}
+
+/// How each step servos: its landmark looked up in the world, the camera from its calibration.
+fn servo_setups(m: &Mission, world: Option<&World>) -> anyhow::Result<Vec<Option<ServoSetup>>> {
+    m.steps
+        .iter()
+        .enumerate()
+        .map(|(i, s)| {
+            let (Some(name), Some(sv)) = (&s.servo_landmark, m.servo) else { return Ok(None) };
+            let w = world.with_context(|| format!("mission.step[{i}] servos on {name}: pass --world"))?;
+            let (index, l) = w
+                .landmarks
+                .iter()
+                .enumerate()
+                .find(|(_, l)| &l.name == name)
+                .with_context(|| format!("mission.step[{i}]: no landmark {name} in world {}", w.name))?;
+            let base = l.point();
+            let v = s.servo_vertex_m;
+            Ok(Some(ServoSetup {
+                landmark_index: index as u32,
+                point: [base[0] + v[0], base[1] + v[1], base[2] + v[2]],
+                offset: v,
+                params: ServoParams {
+                    focal_px: w.camera.focal_for(w.camera.width_px),
+                    misalignment_rad: sv.misalignment_deg.to_radians(),
+                    aim_m: sv.aim_m,
+                },
+                width_px: w.camera.width_px,
+                height_px: w.camera.height_px,
+                camera_height_m: w.camera.height_m,
+                tracking: sv.offset,
+            }))
+        })
+        .collect()
 }
 
 fn main() -> anyhow::Result<()> {
@@ -24,6 +65,8 @@ fn main() -> anyhow::Result<()> {
     let text = std::fs::read_to_string(&args.mission)
         .with_context(|| format!("reading {}", args.mission.display()))?;
     let mission = mission::parse(&text, &args.mission.display().to_string()).map_err(anyhow::Error::msg)?;
+    let world = args.world.as_deref().map(World::load).transpose()?;
+    let servo = servo_setups(&mission, world.as_ref())?;
     tracing::info!(description = %mission.description, steps = mission.steps.len(), "mission loaded");
 
     let bus = Bus::join("executive")?;
@@ -31,15 +74,18 @@ fn main() -> anyhow::Result<()> {
     let sonar = bus.subscriber(topics::SONAR_RING)?;
     let detections = bus.subscriber(topics::VISION_DETECTIONS)?;
     let maps = bus.subscriber(topics::UMS_MAP)?;
+    let results = bus.subscriber(topics::VISION_RESULTS)?;
     let commands = bus.publisher(topics::VEHICLE_COMMAND)?;
     let status = bus.publisher(topics::EXECUTIVE_STATUS)?;
+    let requests = bus.publisher(topics::VISION_REQUESTS)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps])?;
+    let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps, &results])?;
     harvey_runtime::notify_ready()?;
 
-    let mut exec = Executive::new(mission);
-    let mut odos = Vec::new();
+    let mut exec = Executive::new(mission, servo);
+    let (mut odos, mut seen) = (Vec::new(), Vec::new());
+    let mut out = Vec::new();
     while exec.state() == MissionState::Running {
         if pace.next(&waiter, None)? == Step::Stop {
             tracing::warn!("stopped before the mission ended");
@@ -48,27 +94,46 @@ fn main() -> anyhow::Result<()> {
         exec.sonar_rings_seen += sonar.drain(|_| {})? as u64;
         exec.detections_seen += detections.drain(|_| {})? as u64;
         exec.maps_seen += maps.drain(|_| {})? as u64;
+        results.drain_into(&mut seen)?;
         odometry.drain_into(&mut odos)?;
+        out.clear();
+        for r in &seen {
+            out.extend(exec.on_vision(r));
+        }
         for o in &odos {
-            for out in exec.on_odometry(o) {
-                match out {
-                    Output::Command(c) => {
-                        tracing::info!(
-                            id = c.command_id,
-                            kind = c.kind,
-                            distance_m = c.distance_m,
-                            angle_rad = c.angle_rad,
-                            "command"
-                        );
-                        commands.send(&c)?;
-                    }
-                    Output::Status(s) => {
-                        status.send(&s)?;
-                    }
+            out.extend(exec.on_odometry(o));
+        }
+        for o in &out {
+            match o {
+                Output::Command(c) => {
+                    tracing::info!(
+                        id = c.command_id,
+                        kind = c.kind,
+                        distance_m = c.distance_m,
+                        angle_rad = c.angle_rad,
+                        "command"
+                    );
+                    commands.send(c)?;
+                }
+                Output::Look(r) => {
+                    requests.send(r)?;
+                }
+                Output::Status(s) => {
+                    status.send(s)?;
                 }
             }
         }
         pace.done()?;
+    }
+    for (k, leg) in exec.legs.iter().enumerate() {
+        let worst = leg.corrections.iter().map(|c| c.1.abs()).fold(0.0, f64::max);
+        tracing::info!(
+            leg = k,
+            corrections = leg.corrections.len(),
+            misses = leg.misses,
+            largest_correction_deg = worst.to_degrees(),
+            "servoed leg"
+        );
     }
     match exec.state() {
         MissionState::Succeeded => {

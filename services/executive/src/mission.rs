@@ -1,14 +1,41 @@
 //! The mission a launch file gives the executive: a script of TURN and MOVE primitives with a
-//! time limit. Plan-and-monitor over the locale graph replaces the script in its own issue.
+//! time limit; a move may be driven in increments and servoed on a landmark (000 §5.5).
+//! Plan-and-monitor over the locale graph replaces the script in its own issue.
 
 use serde::Deserialize;
 
-/// One primitive: exactly one of its fields is set.
-#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+/// One primitive: exactly one of `move_m` and `turn_deg` is set. A move may be driven in
+/// increments, and servoed on a landmark after each (000 §5.5).
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Step {
     pub move_m: Option<f64>,
     pub turn_deg: Option<f64>,
+    /// Drive the move in increments of this length.
+    pub increment_m: Option<f64>,
+    /// After each increment, servo on this landmark of the world (needs `increment_m`)…
+    pub servo_landmark: Option<String>,
+    /// …at this offset from the landmark's point (a vertex where reflectances meet, 000 §5.2).
+    #[serde(default)]
+    pub servo_vertex_m: [f64; 3],
+}
+
+/// Action-level servoing settings (`[mission.servo]`).
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Servo {
+    /// The point ahead on the intended line to steer for (m).
+    pub aim_m: f64,
+    /// The camera's yaw from the direction of motion, as calibrated (degrees, left positive).
+    #[serde(default)]
+    pub misalignment_deg: f64,
+    /// Side of the appearance template (pixels) and least correlation score of a sighting.
+    pub template_px: u32,
+    pub min_score: f64,
+    /// `increment` (000 §5.5 as written) or `whole` (the default: the offset summed over the
+    /// leg's increments).
+    #[serde(default)]
+    pub offset: crate::leg::Tracking,
 }
 
 /// The `[mission]` table of a launch file.
@@ -20,6 +47,7 @@ pub struct Mission {
     pub timeout_s: f64,
     #[serde(rename = "step")]
     pub steps: Vec<Step>,
+    pub servo: Option<Servo>,
 }
 
 #[derive(Deserialize)]
@@ -49,6 +77,21 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
                 ));
             }
         }
+        if let Some(inc) = s.increment_m
+            && (s.move_m.is_none() || !greater(inc, 0.0))
+        {
+            return Err(format!("{file}: mission.step[{i}].increment_m must be positive, on a move"));
+        }
+        if s.servo_landmark.is_some() && (s.increment_m.is_none() || m.servo.is_none()) {
+            return Err(format!(
+                "{file}: mission.step[{i}].servo_landmark needs `increment_m` and a [mission.servo] table"
+            ));
+        }
+    }
+    if let Some(sv) = m.servo
+        && (!greater(sv.aim_m, 0.0) || !sv.misalignment_deg.is_finite() || sv.template_px < 4)
+    {
+        return Err(format!("{file}: mission.servo: aim_m must be positive, template_px at least 4"));
     }
     Ok(m)
 }
@@ -68,11 +111,23 @@ mod tests {
         let m = parse(text, "m.toml").expect("parses");
         assert_eq!(
             m.steps,
-            vec![Step { move_m: Some(2.0), turn_deg: None }, Step { move_m: None, turn_deg: Some(90.0) }]
+            vec![
+                Step { move_m: Some(2.0), ..Step::default() },
+                Step { turn_deg: Some(90.0), ..Step::default() }
+            ]
         );
         let both = text.replace("turn_deg = 90", "turn_deg = 90\nmove_m = 1");
         assert!(parse(&both, "m.toml").expect_err("two fields").contains("mission.step[1]"));
         let typo = text.replace("timeout_s", "timeout");
         assert!(parse(&typo, "m.toml").expect_err("unknown field").contains("m.toml: field `mission"));
+        let servoed =
+            text.replace("move_m = 2.0", "move_m = 2.0\nincrement_m = 0.5\nservo_landmark = \"sign\"");
+        let e = parse(&servoed, "m.toml").expect_err("no servo table");
+        assert!(e.contains("step[0].servo_landmark needs"), "{e}");
+        let table = format!("{servoed}[mission.servo]\naim_m = 1.2\ntemplate_px = 16\nmin_score = 0.9\n");
+        let m = parse(&table, "m.toml").expect("parses");
+        assert_eq!((m.steps[0].increment_m, m.servo.map(|s| s.aim_m)), (Some(0.5), Some(1.2)));
+        let on_turn = text.replace("turn_deg = 90", "turn_deg = 90\nincrement_m = 0.5");
+        assert!(parse(&on_turn, "m.toml").expect_err("turn").contains("step[1].increment_m"));
     }
 }

@@ -2,7 +2,8 @@
 //! follows from where a landmark appears in the image, `h = atan((Y - e)/(X + q)) + atan(-x/f)`,
 //! and the robot turns towards a point `D` ahead on the intended line:
 //! `correction = -(h + atan(m sin h / (D + m sin h tan h)))`. A known camera misalignment is
-//! taken off the measured bearing.
+//! taken off the measured bearing. The `_off_line` forms take the robot's whole offset from the
+//! line (tracked increment by increment) instead of one increment's.
 
 /// The camera and the steering aim.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,6 +37,20 @@ pub fn heading_error(landmark: [f64; 2], x_left_px: f64, m: f64, p: &ServoParams
 pub fn correction(h: f64, m: f64, p: &ServoParams) -> f64 {
     let e = m * h.sin();
     -(h + (e / (p.aim_m + e * h.tan())).atan())
+}
+
+/// The heading error when the robot's offset from the intended line is known as a whole
+/// (`offset_m`, left positive) rather than taken as this increment's `m sin h` alone: the
+/// landmark at `(X, Y)` from the expected position is then at `(X, Y - offset)` from the robot.
+pub fn heading_error_off_line(landmark: [f64; 2], x_left_px: f64, offset_m: f64, p: &ServoParams) -> f64 {
+    let bearing = (x_left_px / p.focal_px).atan() + p.misalignment_rad;
+    (landmark[1] - offset_m).atan2(landmark[0]) - bearing
+}
+
+/// The turn that puts a robot `offset_m` off the line with heading error `h` on course for
+/// the point `aim_m` ahead on it: [`correction`] with the whole offset.
+pub fn correction_off_line(h: f64, offset_m: f64, p: &ServoParams) -> f64 {
+    -(h + (offset_m / (p.aim_m + offset_m * h.tan())).atan())
 }
 
 #[cfg(test)]

@@ -13,7 +13,7 @@ use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect, VisionError};
-use harvey_world::{LandmarkClass, World};
+use harvey_world::World;
 
 use crate::templates::{AppearanceTemplate, build_into};
 
@@ -195,11 +195,7 @@ impl Dispatcher {
                     .landmarks
                     .get(req.landmark_index as usize)
                     .ok_or(VisionStatus::UnknownLandmark)?;
-                let p = l.position_m;
-                let base = match l.class {
-                    LandmarkClass::I => [p[0], p[1], p[2] + l.height_m / 2.0],
-                    _ => p,
-                };
+                let base = l.point();
                 let point = [0, 1, 2].map(|k| base[k] + f64::from(req.params[2 + k]));
                 let e = req.expected;
                 let side = param(req, 0, 16.0) as usize;
