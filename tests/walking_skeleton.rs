@@ -82,7 +82,8 @@ fn the_default_mission_runs_records_and_cleans_up() {
             _ => {}
         }
     }
-    for t in topics::ALL {
+    // The sonar reflexes speak only when something is in the way (tests/panic_avoid.rs).
+    for t in topics::ALL.iter().filter(|t| **t != topics::VEHICLE_REFLEX.name) {
         assert!(counts.get(*t).copied().unwrap_or(0) > 0, "no message on {t}: {counts:?}");
     }
     assert!(counts["camera/frame"] >= 50, "{counts:?}");

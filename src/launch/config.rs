@@ -124,6 +124,9 @@ struct File {
     /// The executive's; not the supervisor's business.
     #[allow(dead_code)]
     mission: Option<toml::Value>,
+    /// Moving things for the simulator and the camera (`--movers ${mission}`).
+    #[allow(dead_code)]
+    mover: Option<toml::Value>,
 }
 
 /// A checked launch file.

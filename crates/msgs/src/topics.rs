@@ -65,6 +65,8 @@ pub const SIM_TRUTH: Topic<TruePose> = Topic::new("sim/truth", Qos::STATE);
 pub const DRV_SONAR_RAW: Topic<SonarRaw> = Topic::new("drv/sonar_raw", Qos::STATE);
 pub const DRV_ENCODERS_RAW: Topic<EncodersRaw> = Topic::new("drv/encoders_raw", Qos::STATE);
 pub const VEHICLE_COMMAND: Topic<MotionCommand> = Topic::new("vehicle/command", Qos::STATE);
+/// The sonar reflexes' urgent commands (001 §6.2: straight to the vehicle, over any other).
+pub const VEHICLE_REFLEX: Topic<MotionCommand> = Topic::new("vehicle/reflex", Qos::STATE);
 pub const SONAR_RING: Topic<SonarRing> = Topic::new("sonar/ring", Qos::STATE);
 pub const ODOMETRY: Topic<Odometry> = Topic::new("odometry", Qos::STATE);
 pub const VISION_DETECTIONS: Topic<Detections> = Topic::new("vision/detections", Qos::STATE);
@@ -90,6 +92,7 @@ pub const ALL: &[&str] = &[
     DRV_SONAR_RAW.name,
     DRV_ENCODERS_RAW.name,
     VEHICLE_COMMAND.name,
+    VEHICLE_REFLEX.name,
     SONAR_RING.name,
     ODOMETRY.name,
     VISION_DETECTIONS.name,

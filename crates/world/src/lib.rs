@@ -5,12 +5,14 @@
 mod camera;
 mod load;
 mod model;
+mod movers;
 mod raycast;
 pub mod topology;
 
 pub use camera::project_with;
 pub use load::{WorldError, load_str};
 pub use model::*;
+pub use movers::{Mover, load_movers, parse_movers};
 pub use raycast::Hit;
 pub use topology::{Door, Landmark, LandmarkClass, Locale, Meadow, Strategy};
 

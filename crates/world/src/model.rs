@@ -146,6 +146,11 @@ pub struct World {
     pub meadows: Vec<Meadow>,
     #[serde(default, rename = "landmark")]
     pub landmarks: Vec<Landmark>,
+    /// Moving things (`movers.rs`), added from a mission; their walls follow `static_walls`.
+    #[serde(skip)]
+    pub(crate) movers: Vec<crate::Mover>,
+    #[serde(skip)]
+    pub(crate) static_walls: usize,
 }
 
 impl World {

@@ -45,6 +45,9 @@ struct Args {
     /// Seed of the sensor noise (the world's camera sets how much).
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// A launch file whose `[[mover]]` tables put moving things in the world.
+    #[arg(long)]
+    movers: Option<PathBuf>,
 }
 
 struct Camera {
@@ -58,6 +61,8 @@ struct Camera {
 impl Camera {
     fn shoot(&mut self, pose: [f64; 3], stamp_ns: u64) -> anyhow::Result<()> {
         self.seq += 1;
+        // Moving things where they are at the frame's simulated time.
+        self.world.set_time(stamp_ns as f64 * 1e-9);
         let r = &self.renderer;
         let header = FrameHeader::new(self.seq, stamp_ns, r.width_px(), r.height_px(), r.encoding());
         let mut frame = self.publisher.loan(header)?;
@@ -116,7 +121,10 @@ fn main() -> anyhow::Result<()> {
         return play_folder(dir, &args);
     }
     let world_path = args.world.as_ref().context("--world or --images is required")?;
-    let world = World::load(world_path)?;
+    let mut world = World::load(world_path)?;
+    if let Some(file) = &args.movers {
+        world.add_movers(harvey_world::load_movers(file)?);
+    }
     let encoding = Encoding::parse(&args.encoding)
         .with_context(|| format!("--encoding `{}`: expected mono8 or rgb8", args.encoding))?;
     let width = args.width.unwrap_or(world.camera.width_px);

@@ -37,6 +37,7 @@ fn main() -> anyhow::Result<()> {
 
     let bus = Bus::join("denning-bridge")?;
     let commands = bus.subscriber(topics::VEHICLE_COMMAND)?;
+    let reflexes = bus.subscriber(topics::VEHICLE_REFLEX)?;
     let encoders = bus.publisher(topics::DRV_ENCODERS_RAW)?;
     let sonar = bus.publisher(topics::DRV_SONAR_RAW)?;
     // Deterministic mode: the bridge is the clock master on the bus. A tick's turn starts when
@@ -50,6 +51,11 @@ fn main() -> anyhow::Result<()> {
         None => waiter.attach(&commands)?,
     };
     let _b = waiter.attach(&line_source)?;
+    // Real time: a reflex's command wakes the bridge too (in lockstep the chain's turn does).
+    let _c = match &lockstep {
+        Some(_) => None,
+        None => Some(waiter.attach(&reflexes)?),
+    };
     harvey_runtime::notify_ready()?;
     tracing::info!(device = %args.device.display(), lockstep = lockstep.is_some(), "bridge up");
 
@@ -59,6 +65,8 @@ fn main() -> anyhow::Result<()> {
     let (mut buf, mut batch, mut ticks) = (Vec::new(), Vec::new(), Vec::new());
     let mut forward = |port: &mut std::fs::File| -> anyhow::Result<()> {
         batch.clear();
+        // The reflexes' commands first: an urgent stop among them pre-empts the batch.
+        reflexes.drain(|c| batch.push(*c))?;
         commands.drain(|c| batch.push(*c))?;
         for cmd in prioritise(&batch) {
             match latch.admit(&cmd).and_then(|()| to_drv(&cmd)) {

@@ -6,6 +6,7 @@
 pub mod fsa;
 pub mod leg;
 pub mod mission;
+pub mod recover;
 pub mod schemas;
 pub mod servo;
 
@@ -42,6 +43,11 @@ enum Phase {
         step: usize,
         request: u32,
     },
+    /// A sonar reflex took the vehicle during step `i`; it last moved at `since_ns`.
+    Preempted {
+        step: usize,
+        since_ns: u64,
+    },
     Done(MissionState),
 }
 
@@ -56,6 +62,14 @@ pub struct Executive {
     /// Every finished leg, for the summary.
     pub legs: Vec<Leg>,
     next_request: u32,
+    /// Where the current step should leave the robot (for getting back to it after a reflex).
+    step_goal: Pose2,
+    /// Primitives still to run to get back to `step_goal`, next last.
+    recovery: Vec<(CommandKind, f64)>,
+    /// Times a reflex interrupted the mission.
+    pub preemptions: u32,
+    /// The latest reflex command already dealt with (the vehicle reports it until ours is taken).
+    handled_reflex: u32,
     phase: Phase,
     start_ns: u64,
     goal: Pose2,
@@ -87,6 +101,10 @@ impl Executive {
             leg: None,
             legs: Vec::new(),
             next_request: REQUEST_BASE,
+            step_goal: Pose2::default(),
+            recovery: Vec::new(),
+            preemptions: 0,
+            handled_reflex: 0,
             phase: Phase::Waiting,
             start_ns: 0,
             goal: Pose2::default(),
@@ -122,6 +140,7 @@ impl Executive {
 
     /// Starts step `step` from the pose `at`.
     fn begin(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
+        self.step_goal = goal_of(at, std::slice::from_ref(&self.mission.steps[step]));
         let s: &Step = &self.mission.steps[step];
         match (s.move_m, s.turn_deg, s.increment_m) {
             (Some(d), _, Some(inc)) => {
@@ -192,6 +211,15 @@ impl Executive {
         }
     }
 
+    /// The next primitive of the way back to the interrupted step's goal, or the next step.
+    fn resume(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
+        match self.recovery.pop() {
+            Some((kind, v)) if kind == CommandKind::Move => vec![self.send(step, kind, v, 0.0, now)],
+            Some((kind, v)) => vec![self.send(step, kind, 0.0, v, now)],
+            None => self.step_done(step, at, now),
+        }
+    }
+
     /// A vision result: the answer to the leg's look, if it is the one awaited.
     pub fn on_vision(&mut self, r: &VisionResult) -> Vec<Output> {
         let Phase::Looking { step, request } = self.phase else { return Vec::new() };
@@ -217,9 +245,36 @@ impl Executive {
                 self.goal = goal_of(o.world_from_robot, &self.mission.steps);
                 out = self.begin(0, o.world_from_robot, now);
             }
+            Phase::Executing { step, .. } | Phase::Looking { step, .. }
+                if recover::is_reflex(o.command.command_id)
+                    && o.command.command_id != self.handled_reflex =>
+            {
+                tracing::warn!(step, "a reflex took the vehicle; the step resumes once it is over");
+                self.preemptions += 1;
+                self.handled_reflex = o.command.command_id;
+                self.leg = None;
+                self.recovery.clear();
+                self.phase = Phase::Preempted { step, since_ns: now };
+            }
+            Phase::Preempted { step, since_ns } => {
+                let fresh =
+                    recover::is_reflex(o.command.command_id) && o.command.command_id != self.handled_reflex;
+                if fresh {
+                    self.handled_reflex = o.command.command_id;
+                }
+                if fresh || o.moving != 0 || o.command_accepted == 0 {
+                    self.phase = Phase::Preempted { step, since_ns: now };
+                } else if now.saturating_sub(since_ns) >= recover::QUIET_NS {
+                    self.recovery = recover::back_to(o.world_from_robot, self.step_goal);
+                    self.recovery.reverse();
+                    out = self.resume(step, o.world_from_robot, now);
+                }
+            }
             Phase::Executing { step, id } => {
                 let finished = o.command.command_id == id && o.command_accepted == 1 && o.moving == 0;
-                if finished {
+                if finished && !self.recovery.is_empty() {
+                    out = self.resume(step, o.world_from_robot, now);
+                } else if finished {
                     out = match self.leg.as_mut() {
                         Some(leg) => {
                             let next = leg.on_done();
@@ -249,7 +304,9 @@ impl Executive {
         self.seq += 1;
         let step = match self.phase {
             Phase::Waiting => 0,
-            Phase::Executing { step, .. } | Phase::Looking { step, .. } => step,
+            Phase::Executing { step, .. } | Phase::Looking { step, .. } | Phase::Preempted { step, .. } => {
+                step
+            }
             Phase::Done(_) => self.mission.steps.len(),
         };
         MissionStatus {
@@ -313,6 +370,39 @@ mod tests {
             (s.goal.x_m - 2.0).abs() < 1e-12
                 && (s.goal.heading_rad - std::f64::consts::FRAC_PI_2).abs() < 1e-12
         );
+    }
+
+    #[test]
+    fn after_a_reflex_the_interrupted_step_is_finished_from_where_the_robot_is() {
+        let one = Mission { steps: vec![Step { move_m: Some(4.0), ..Step::default() }], ..mission(60.0) };
+        let mut e = Executive::new(one, Vec::new());
+        let out = e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false));
+        let Output::Command(mv) = out[0] else { panic!("{out:?}") };
+        // The sonar's panic-avoid takes over 2 m in, and keeps the vehicle busy for a while.
+        let reflex =
+            |id: u32| MotionCommand { command_id: 0x8000_0000 | id, urgent: 1, ..MotionCommand::default() };
+        assert_eq!(e.on_odometry(&odo(1.0, 1.0, mv, true, true)).len(), 1);
+        assert_eq!(e.on_odometry(&odo(7.0, 2.0, reflex(1), true, false)).len(), 1);
+        assert_eq!(e.on_odometry(&odo(8.0, 2.0, reflex(2), true, true)).len(), 1);
+        assert_eq!(e.preemptions, 1);
+        let mut at = odo(12.0, 2.0, reflex(3), true, false);
+        at.world_from_robot = Pose2 { x_m: 2.0, y_m: 0.9, heading_rad: std::f64::consts::FRAC_PI_2 };
+        assert_eq!(e.on_odometry(&at).len(), 1, "quiet for less than 2 s");
+        at.header.stamp_ns = 14_500_000_000;
+        let out = e.on_odometry(&at);
+        let Output::Command(turn) = out[0] else { panic!("{out:?}") };
+        assert_eq!(turn.kind, CommandKind::Turn as u32);
+        assert!((turn.angle_rad - (-std::f64::consts::FRAC_PI_2 + (-0.9f64).atan2(2.0))).abs() < 1e-9);
+        // The vehicle still reports the reflex's last command: no new preemption.
+        assert_eq!(e.on_odometry(&at).len(), 1);
+        let out = e.on_odometry(&odo(16.0, 2.0, turn, true, false));
+        let Output::Command(go) = out[0] else { panic!("{out:?}") };
+        assert!(go.kind == CommandKind::Move as u32 && (go.distance_m - 2.0f64.hypot(0.9)).abs() < 1e-9);
+        let out = e.on_odometry(&odo(24.0, 4.0, go, true, false));
+        let Output::Command(last) = out[0] else { panic!("{out:?}") };
+        assert_eq!(last.kind, CommandKind::Turn as u32);
+        e.on_odometry(&odo(26.0, 4.0, last, true, false));
+        assert_eq!((e.state(), e.preemptions), (MissionState::Succeeded, 1));
     }
 
     #[test]

@@ -25,7 +25,9 @@ pub fn draw_recorded(w: &mut RrdWriter, topic: &str, data: &[u8]) -> Result<bool
         _ if t == topics::SIM_TRUTH.name => draw::<TruePose>(w, data)?,
         _ if t == topics::DRV_SONAR_RAW.name => draw::<SonarRaw>(w, data)?,
         _ if t == topics::DRV_ENCODERS_RAW.name => draw::<EncodersRaw>(w, data)?,
-        _ if t == topics::VEHICLE_COMMAND.name => draw::<MotionCommand>(w, data)?,
+        _ if t == topics::VEHICLE_COMMAND.name || t == topics::VEHICLE_REFLEX.name => {
+            draw::<MotionCommand>(w, data)?
+        }
         _ if t == topics::SONAR_RING.name => draw::<SonarRing>(w, data)?,
         _ if t == topics::ODOMETRY.name => draw::<Odometry>(w, data)?,
         _ if t == topics::VISION_DETECTIONS.name => draw::<Detections>(w, data)?,

@@ -79,6 +79,7 @@ fn main() -> anyhow::Result<()> {
         tap(&bus, &mut rec, topics::DRV_SONAR_RAW)?,
         tap(&bus, &mut rec, topics::DRV_ENCODERS_RAW)?,
         tap(&bus, &mut rec, topics::VEHICLE_COMMAND)?,
+        tap(&bus, &mut rec, topics::VEHICLE_REFLEX)?,
         tap(&bus, &mut rec, topics::SONAR_RING)?,
         tap(&bus, &mut rec, topics::ODOMETRY)?,
         tap(&bus, &mut rec, topics::VISION_DETECTIONS)?,

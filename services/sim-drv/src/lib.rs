@@ -145,6 +145,8 @@ impl SimDrv {
     /// Advances time by one tick: moves, fires the next sonar bank, reports encoders.
     pub fn tick(&mut self) -> TickOutput {
         self.time_ms += self.tick_ms;
+        // Moving things are where their timetables put them now (no-op in a still world).
+        self.world.set_time(self.time_ms as f64 / 1000.0);
         let dt_s = self.tick_ms as f64 / 1000.0;
         if let Some(m) = &mut self.motion {
             let t = self.world.terrain_at(self.truth.x, self.truth.y);

@@ -31,13 +31,19 @@ struct Args {
     /// Seed of the error model.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// A launch file whose `[[mover]]` tables put moving things in the world.
+    #[arg(long)]
+    movers: Option<PathBuf>,
 }
 
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
     anyhow::ensure!(args.tick_ms > 0 && args.speedup > 0.0, "--tick-ms and --speedup must be positive");
-    let world = harvey_world::World::load(&args.world)?;
+    let mut world = harvey_world::World::load(&args.world)?;
+    if let Some(file) = &args.movers {
+        world.add_movers(harvey_world::load_movers(file)?);
+    }
     let mut sim = SimDrv::new(world, args.tick_ms, args.seed);
 
     let bus = Bus::join("sim-drv")?;

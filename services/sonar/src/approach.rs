@@ -37,8 +37,10 @@ struct Window {
     c: [f64; WINDOW],
     heading: [f64; WINDOW],
     last_stamp: u64,
-    /// Consecutive readings that showed an approach.
+    /// Consecutive readings that showed an approach within the time to contact.
     streak: u32,
+    /// The latest reading showed something coming, however far.
+    closing: bool,
 }
 
 impl Window {
@@ -119,7 +121,8 @@ impl Approach {
     }
 
     /// Folds in a ring's new readings; returns the mask of sensors whose latest reading showed
-    /// an approach.
+    /// something coming at the robot at least the least approach speed, whatever its time to
+    /// contact (the streaks count readings within it).
     pub fn on_ring(&mut self, ring: &SonarRing) -> u32 {
         let mut mask = 0;
         let v = self.velocity();
@@ -133,7 +136,7 @@ impl Approach {
                 continue;
             }
             if stamp <= w.last_stamp {
-                mask |= u32::from(w.streak > 0) << i;
+                mask |= u32::from(w.closing) << i;
                 continue; // no new reading of this sensor
             }
             w.last_stamp = stamp;
@@ -145,11 +148,10 @@ impl Approach {
             w.push(stamp as f64 * 1e-9, f64::from(r) + x * u[0] + y * u[1], th);
             let approach = w.slope().map_or(0.0, |s| -s);
             let closing = approach + v[0] * u[0] + v[1] * u[1];
-            let coming = approach >= self.p.min_approach_mps
-                && closing > 0.0
-                && f64::from(r) / closing <= self.p.ttc_s;
+            w.closing = approach >= self.p.min_approach_mps && closing > 0.0;
+            let coming = w.closing && f64::from(r) / closing <= self.p.ttc_s;
             w.streak = if coming { w.streak + 1 } else { 0 };
-            mask |= u32::from(coming) << i;
+            mask |= u32::from(w.closing) << i;
         }
         mask
     }

@@ -28,6 +28,8 @@ pub struct AvoidParams {
     pub turn_rad: f64,
     /// Length of one sideways dash (m).
     pub dash_m: f64,
+    /// The panic-stop distance (m): no dash heads for anything nearer than this plus the dash.
+    pub stop_m: f64,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,11 +45,25 @@ enum Phase {
         id: u32,
         sent_ns: u64,
     },
+    /// No room for another dash: the robot keeps still (an urgent stop every `HOLD_NS`) until
+    /// the object stops approaching.
+    Holding {
+        sent_ns: u64,
+    },
 }
+
+/// While holding, the stop is repeated this often (ns), so that the executive sees the reflex
+/// still has the vehicle.
+const HOLD_NS: u64 = 500_000_000;
 
 /// A step the vehicle neither ran nor is running after this long is sent again (the vehicle
 /// refused it, or another command took its place).
 const RESEND_NS: u64 = 1_000_000_000;
+
+/// A dash stops this far (m) short of the panic-stop distance from what is ahead, and one
+/// shorter than `MIN_DASH_M` is not worth making.
+const DASH_MARGIN_M: f64 = 0.05;
+const MIN_DASH_M: f64 = 0.1;
 
 /// A sensor's readings over a turn of more than this (3 degrees) are not compared.
 const MAX_TURN_RAD: f64 = 0.052;
@@ -59,8 +75,11 @@ pub struct PanicAvoid {
     approach: Approach,
     /// Set by the latest ring: some sensor (any bearing) saw an approach.
     approaching: bool,
-    /// Clearance at the left and right (m) from the latest ring.
+    /// Clearance at the left, right and straight ahead (m) from the latest ring.
     clearance: [f64; 2],
+    ahead_m: f64,
+    /// The way to turn: +1 left, -1 right (away from the object, else to the clearer side).
+    away: f64,
     moving: bool,
     phase: Phase,
     next_id: u32,
@@ -80,6 +99,8 @@ impl PanicAvoid {
             approach,
             approaching: false,
             clearance: [0.0; 2],
+            ahead_m: 0.0,
+            away: 1.0,
             moving: false,
             phase: Phase::Watching,
             next_id: ID_BASE,
@@ -119,20 +140,33 @@ impl PanicAvoid {
         self.moving = o.moving != 0;
         let finished = |id: u32| o.command.command_id == id && o.command_accepted == 1 && o.moving == 0;
         let lost = |id: u32, sent: u64| o.command.command_id != id && o.moving == 0 && t > sent + RESEND_NS;
-        let turn = if self.clearance[0] >= self.clearance[1] { self.p.turn_rad } else { -self.p.turn_rad };
+        let turn = self.away * self.p.turn_rad;
         match self.phase {
-            // Towards the clearer side: left is a positive turn.
+            // Away from the object (left is a positive turn).
             Phase::Stopping if !self.moving => Some(self.turn(t, turn)),
             Phase::Turning { id, sent_ns } if lost(id, sent_ns) => Some(self.turn(t, turn)),
-            Phase::Dashing { id, sent_ns } if lost(id, sent_ns) => Some(self.dash(t)),
-            Phase::Turning { id, .. } if finished(id) => Some(self.dash(t)),
-            Phase::Dashing { id, .. } if finished(id) => {
+            Phase::Dashing { id, sent_ns } if lost(id, sent_ns) => {
+                Some(self.dash(t, (self.ahead_m - self.p.stop_m - DASH_MARGIN_M).min(self.p.dash_m).max(0.0)))
+            }
+            Phase::Turning { id, .. } | Phase::Dashing { id, .. } if finished(id) => {
+                let first = matches!(self.phase, Phase::Turning { .. });
+                // A dash, and more while the object still approaches, cut short of anything
+                // ahead (the panic-stop would freeze the robot there anyway).
+                let room = (self.ahead_m - self.p.stop_m - DASH_MARGIN_M).min(self.p.dash_m);
+                if (first || self.approaching) && room >= MIN_DASH_M {
+                    return Some(self.dash(t, room));
+                }
                 if self.approaching {
-                    return Some(self.dash(t));
+                    return Some(self.hold(t));
                 }
                 self.phase = Phase::Watching;
                 None
             }
+            Phase::Holding { .. } if !self.approaching => {
+                self.phase = Phase::Watching;
+                None
+            }
+            Phase::Holding { sent_ns } if t >= sent_ns + HOLD_NS => Some(self.hold(t)),
             _ => None,
         }
     }
@@ -143,8 +177,13 @@ impl PanicAvoid {
         c
     }
 
-    fn dash(&mut self, t: u64) -> MotionCommand {
-        let c = self.command(CommandKind::Move, t, self.p.dash_m, 0.0);
+    fn hold(&mut self, t: u64) -> MotionCommand {
+        self.phase = Phase::Holding { sent_ns: t };
+        self.command(CommandKind::Stop, t, 0.0, 0.0)
+    }
+
+    fn dash(&mut self, t: u64, length_m: f64) -> MotionCommand {
+        let c = self.command(CommandKind::Move, t, length_m, 0.0);
         self.phase = Phase::Dashing { id: c.command_id, sent_ns: t };
         c
     }
@@ -161,7 +200,20 @@ impl PanicAvoid {
         };
         let quarter = SONAR_SENSORS / 4;
         self.clearance = [side(quarter), side(3 * quarter)];
+        self.ahead_m = side(0);
         if trigger && self.phase == Phase::Watching {
+            // Away from the side the approaching echoes come from; the clearer side on a tie.
+            let side: f64 = (0..SONAR_SENSORS)
+                .filter(|&i| self.approach.streak(i) > 0)
+                .map(|i| bearing_rad(i).sin())
+                .filter(|s| s.abs() > 1e-9 && s.abs() < self.p.arc_rad.sin() + 1e-9)
+                .sum();
+            self.away = match side {
+                s if s < -1e-9 => 1.0,
+                s if s > 1e-9 => -1.0,
+                _ if self.clearance[0] >= self.clearance[1] => 1.0,
+                _ => -1.0,
+            };
             self.episodes += 1;
             self.phase = Phase::Stopping;
             return Some(self.command(CommandKind::Stop, ring.header.stamp_ns, 0.0, 0.0));
@@ -182,6 +234,7 @@ mod tests {
         arc_rad: std::f64::consts::FRAC_PI_6,
         turn_rad: std::f64::consts::FRAC_PI_2,
         dash_m: 0.9,
+        stop_m: 0.61,
     };
 
     /// A ring read at `t` s: `ahead` m on sensor 0, `left` and `right` on sensors 6 and 18,

@@ -14,7 +14,9 @@ struct Args {
     #[arg(long, default_value_t = 2.0)]
     panic_stop_ft: f64,
     /// Panic-avoid: an object approaching head-on with less than this time to contact (s)…
-    #[arg(long, default_value_t = 4.0)]
+    /// (the paper gives none; the DRV needs about 6 s to turn a right angle at 30 deg/s and dash
+    /// 2 ft at 1 ft/s, plus a second to confirm the approach)
+    #[arg(long, default_value_t = 8.0)]
     avoid_ttc_s: f64,
     /// …over this many consecutive readings ("several", 001 §6.2)…
     #[arg(long, default_value_t = 3)]
@@ -27,7 +29,7 @@ struct Args {
     avoid_turn_deg: f64,
     /// …and dash this far to the side, again while the object still approaches (0: no
     /// panic-avoid).
-    #[arg(long, default_value_t = 3.0)]
+    #[arg(long, default_value_t = 2.0)]
     avoid_dash_ft: f64,
 }
 
@@ -38,7 +40,7 @@ fn main() -> anyhow::Result<()> {
     let raw = bus.subscriber(topics::DRV_SONAR_RAW)?;
     let odometry = bus.subscriber(topics::ODOMETRY)?;
     let ring_pub = bus.publisher(topics::SONAR_RING)?;
-    let command_pub = bus.publisher(topics::VEHICLE_COMMAND)?;
+    let command_pub = bus.publisher(topics::VEHICLE_REFLEX)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&raw, &odometry])?;
@@ -54,6 +56,7 @@ fn main() -> anyhow::Result<()> {
             arc_rad: std::f64::consts::FRAC_PI_6,
             turn_rad: args.avoid_turn_deg.to_radians(),
             dash_m: args.avoid_dash_ft * FT,
+            stop_m: args.panic_stop_ft * FT,
         })
     });
     let (mut banks, mut poses) = (Vec::new(), Vec::new());

@@ -1,0 +1,160 @@
+//! Things that move through the world on a timetable (a cart down the hall, a passer-by, a
+//! door's occluder): a footprint polygon with a height and a reflectance, driven along
+//! time-stamped waypoints. A mission's launch file lists them as `[[mover]]` tables; the
+//! simulator's sonar and the camera place them at each tick's simulated time, as walls.
+
+use serde::Deserialize;
+
+use crate::{Wall, World, WorldError};
+
+/// One moving thing.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Mover {
+    pub name: String,
+    /// Footprint corners around its reference point (m), in order.
+    pub outline: Vec<[f64; 2]>,
+    pub height_m: f64,
+    pub reflectance: f64,
+    /// `[t_s, x_m, y_m]`: where the reference point is at simulated time `t_s`; in between it
+    /// moves in a straight line, before the first and after the last it stands still.
+    pub path: Vec<[f64; 3]>,
+}
+
+impl Mover {
+    /// Where its reference point is at `t_s`.
+    pub fn at(&self, t_s: f64) -> [f64; 2] {
+        let p = &self.path;
+        let k = p.iter().position(|w| w[0] > t_s).unwrap_or(p.len());
+        match k {
+            0 => [p[0][1], p[0][2]],
+            k if k == p.len() => [p[k - 1][1], p[k - 1][2]],
+            k => {
+                let (a, b) = (p[k - 1], p[k]);
+                let f = (t_s - a[0]) / (b[0] - a[0]);
+                [a[1] + f * (b[1] - a[1]), a[2] + f * (b[2] - a[2])]
+            }
+        }
+    }
+}
+
+#[derive(Deserialize)]
+struct File {
+    #[serde(default, rename = "mover")]
+    movers: Vec<Mover>,
+}
+
+/// The `[[mover]]` tables of a launch file (other tables are other services' business).
+pub fn parse_movers(text: &str, file: &str) -> Result<Vec<Mover>, WorldError> {
+    let bad = |detail: String| WorldError::Inconsistent { file: file.to_owned(), detail };
+    let doc: toml::Table = toml::from_str(text)
+        .map_err(|e| WorldError::Io { file: file.to_owned(), detail: e.message().to_owned() })?;
+    let only: toml::Table = doc.into_iter().filter(|(k, _)| k == "mover").collect();
+    let parsed: File = serde_path_to_error::deserialize(only).map_err(|e| WorldError::Parse {
+        file: file.to_owned(),
+        line: 0,
+        field: e.path().to_string(),
+        detail: e.inner().message().to_owned(),
+    })?;
+    for m in &parsed.movers {
+        let finite = m.outline.iter().flatten().chain(m.path.iter().flatten()).all(|v| v.is_finite());
+        if m.outline.len() < 3 || m.path.is_empty() || !finite {
+            return Err(bad(format!(
+                "mover {}: needs 3 or more outline corners and a path of finite numbers",
+                m.name
+            )));
+        }
+        if m.path.windows(2).any(|w| w[1][0] <= w[0][0]) {
+            return Err(bad(format!("mover {}: path times must increase", m.name)));
+        }
+        if m.height_m.is_nan() || m.height_m <= 0.0 || !(0.0..=1.0).contains(&m.reflectance) {
+            return Err(bad(format!("mover {}: height must be positive, reflectance in 0..=1", m.name)));
+        }
+    }
+    Ok(parsed.movers)
+}
+
+/// [`parse_movers`] on a file.
+pub fn load_movers(path: &std::path::Path) -> Result<Vec<Mover>, WorldError> {
+    let file = path.display().to_string();
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| WorldError::Io { file: file.clone(), detail: e.to_string() })?;
+    parse_movers(&text, &file)
+}
+
+impl World {
+    /// Adds moving things; their walls follow the static ones and [`World::set_time`] places them.
+    pub fn add_movers(&mut self, movers: Vec<Mover>) {
+        if self.movers.is_empty() {
+            self.static_walls = self.walls.len();
+        }
+        self.movers.extend(movers);
+        self.set_time(0.0);
+    }
+
+    /// Puts every mover where it is at simulated time `t_s` (its outline's edges become walls).
+    pub fn set_time(&mut self, t_s: f64) {
+        if self.movers.is_empty() {
+            return;
+        }
+        self.walls.truncate(self.static_walls);
+        for m in &self.movers {
+            let [x, y] = m.at(t_s);
+            let n = m.outline.len();
+            for k in 0..n {
+                let (a, b) = (m.outline[k], m.outline[(k + 1) % n]);
+                self.walls.push(Wall {
+                    from: [x + a[0], y + a[1]],
+                    to: [x + b[0], y + b[1]],
+                    height_m: m.height_m,
+                    reflectance: m.reflectance,
+                    colour: [1.0, 1.0, 1.0],
+                    regions: Vec::new(),
+                });
+            }
+        }
+    }
+
+    pub fn movers(&self) -> &[Mover] {
+        &self.movers
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const CART: &str = "[launch]\nname = \"x\"\n[[mover]]\nname = \"cart\"\noutline = [[-0.3, -0.25], [0.3, -0.25], [0.3, 0.25], [-0.3, 0.25]]\nheight_m = 1.0\nreflectance = 0.3\npath = [[2.0, 10.0, 0.0], [12.0, 5.0, 0.0]]\n";
+
+    #[test]
+    fn a_mover_follows_its_timetable_and_becomes_walls() {
+        let movers = parse_movers(CART, "m.toml").expect("parses");
+        let cart = &movers[0];
+        assert_eq!(cart.at(0.0), [10.0, 0.0]);
+        assert_eq!(cart.at(7.0), [7.5, 0.0]);
+        assert_eq!(cart.at(99.0), [5.0, 0.0]);
+        let mut w = crate::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("world");
+        let walls = w.walls.len();
+        let ahead = |w: &World| w.cast_ray([0.0, 0.0], [1.0, 0.0], 30.0).map(|h| h.distance_m);
+        let without = ahead(&w).expect("the end wall");
+        w.add_movers(movers);
+        assert_eq!(w.walls.len(), walls + 4);
+        assert!((ahead(&w).expect("the cart") - 9.7).abs() < 1e-9);
+        w.set_time(12.0);
+        assert!((ahead(&w).expect("the cart") - 4.7).abs() < 1e-9);
+        assert_eq!(w.walls.len(), walls + 4, "placing again replaces the mover's walls");
+        assert!(without > 15.0);
+    }
+
+    #[test]
+    fn bad_movers_are_named() {
+        let e =
+            parse_movers(&CART.replace("[12.0, 5.0", "[1.0, 5.0"), "m.toml").expect_err("times").to_string();
+        assert!(e.contains("m.toml") && e.contains("mover cart: path times must increase"), "{e}");
+        let e = parse_movers(&CART.replace("height_m = 1.0", "height_m = -1.0"), "m.toml")
+            .expect_err("h")
+            .to_string();
+        assert!(e.contains("mover cart"), "{e}");
+        assert_eq!(parse_movers("[launch]\nname = \"x\"\n", "m.toml").expect("none").len(), 0);
+    }
+}

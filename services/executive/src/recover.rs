@@ -1,0 +1,66 @@
+//! Getting back to the plan after a reflex took the vehicle (001 §6.2: once a panic-avoid
+//! episode is over, "special procedures are invoked to allow the robot to regain its bearings and
+//! then satisfy the previously specified navigational goals"): from where dead reckoning says
+//! the robot now is, face the interrupted step's goal, drive to it and take its heading.
+
+use harvey_msgs::{CommandKind, Pose2};
+
+/// Command ids with this bit set are the sonar reflexes' (`harvey_sonar::avoid`).
+pub const REFLEX_ID_BIT: u32 = 0x8000_0000;
+
+/// Whether the vehicle's current command is a reflex's.
+pub fn is_reflex(command_id: u32) -> bool {
+    command_id & REFLEX_ID_BIT != 0
+}
+
+/// Quiet time (ns) after a reflex's last motion before the executive takes over again.
+pub const QUIET_NS: u64 = 2_000_000_000;
+
+/// `a` in `(-π, π]`.
+pub fn wrap(a: f64) -> f64 {
+    let t = a.rem_euclid(std::f64::consts::TAU);
+    if t > std::f64::consts::PI { t - std::f64::consts::TAU } else { t }
+}
+
+/// The primitives from `at` to `goal`: TURN to face it, MOVE there, TURN to its heading (each
+/// left out when negligible), in order.
+pub fn back_to(at: Pose2, goal: Pose2) -> Vec<(CommandKind, f64)> {
+    let (dx, dy) = (goal.x_m - at.x_m, goal.y_m - at.y_m);
+    let d = dx.hypot(dy);
+    let mut out = Vec::new();
+    let mut heading = at.heading_rad;
+    if d > 0.01 {
+        let face = wrap(dy.atan2(dx) - heading);
+        if face.abs() > 1e-3 {
+            out.push((CommandKind::Turn, face));
+        }
+        heading += face;
+        out.push((CommandKind::Move, d));
+    }
+    let last = wrap(goal.heading_rad - heading);
+    if last.abs() > 1e-3 {
+        out.push((CommandKind::Turn, last));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn back_to_the_goal_after_a_sideways_dash() {
+        // Evaded: turned left a right angle and dashed 0.9 m; the step wanted (4, 0) heading 0.
+        let at = Pose2 { x_m: 2.0, y_m: 0.9, heading_rad: std::f64::consts::FRAC_PI_2 };
+        let goal = Pose2 { x_m: 4.0, y_m: 0.0, heading_rad: 0.0 };
+        let steps = back_to(at, goal);
+        assert_eq!(steps.len(), 3);
+        let face = -std::f64::consts::FRAC_PI_2 + (-0.9f64).atan2(2.0);
+        assert!(steps[0].0 == CommandKind::Turn && (steps[0].1 - face).abs() < 1e-12);
+        assert!(steps[1].0 == CommandKind::Move && (steps[1].1 - 2.0f64.hypot(0.9)).abs() < 1e-12);
+        assert!(steps[2].0 == CommandKind::Turn && (steps[2].1 + (-0.9f64).atan2(2.0)).abs() < 1e-12);
+        assert!(back_to(goal, goal).is_empty());
+        assert!(is_reflex(0x8000_0003) && !is_reflex(3));
+        assert!((wrap(3.5 * std::f64::consts::PI) + 0.5 * std::f64::consts::PI).abs() < 1e-12);
+    }
+}
