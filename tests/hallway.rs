@@ -4,14 +4,21 @@
 
 mod common;
 
-use harvey_msgs::{TruePose, VisionResult, VisionStatus};
+use harvey_msgs::{MissionStatus, ServoCorrection, ServoLevel, TruePose, VisionResult, VisionStatus};
 
 const INCH: f64 = 0.0254;
 const FT: f64 = 0.3048;
 
-/// Runs a mission; returns the true poses (x, y along and across the line, which is the x axis)
-/// and the executive's correlation results.
-fn run(mission: &str, tag: &str, steps: &str) -> (Vec<[f64; 2]>, Vec<VisionResult>) {
+/// What a run recorded: the true poses (x, y along and across the line, which is the x axis),
+/// the executive's correlation results, its corrections, and the servo levels it reported.
+struct Run {
+    truth: Vec<[f64; 2]>,
+    looks: Vec<VisionResult>,
+    corrections: Vec<ServoCorrection>,
+    levels: Vec<u32>,
+}
+
+fn run(mission: &str, tag: &str, steps: &str) -> Run {
     let prefix = common::unique_prefix(tag);
     let dir = common::scratch(tag);
     let out =
@@ -25,13 +32,20 @@ fn run(mission: &str, tag: &str, steps: &str) -> (Vec<[f64; 2]>, Vec<VisionResul
         String::from_utf8_lossy(&out.stderr)
     );
     let bytes = std::fs::read(dir.join("run.mcap")).expect("recording");
-    let (mut truth, mut looks) = (Vec::new(), Vec::new());
+    let (mut truth, mut looks, mut corrections, mut levels) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for m in mcap::MessageStream::new(&bytes).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
             "/sim/truth" => {
                 let p = harvey_cdr::decode::<TruePose>(&m.data).expect("truth").world_from_robot;
                 truth.push([p.x_m, p.y_m]);
+            }
+            "/executive/servo" => {
+                corrections.push(harvey_cdr::decode::<ServoCorrection>(&m.data).expect("correction"))
+            }
+            "/executive/status" => {
+                levels.push(harvey_cdr::decode::<MissionStatus>(&m.data).expect("status").servo)
             }
             "/vision/results" => {
                 let r = harvey_cdr::decode::<VisionResult>(&m.data).expect("result");
@@ -43,7 +57,7 @@ fn run(mission: &str, tag: &str, steps: &str) -> (Vec<[f64; 2]>, Vec<VisionResul
         }
     }
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
-    (truth, looks)
+    Run { truth, looks, corrections, levels }
 }
 
 /// The largest offset from the line over the stretch `from_ft ..= to_ft` of it.
@@ -57,7 +71,7 @@ fn worst(truth: &[[f64; 2]], from_ft: f64, to_ft: f64) -> f64 {
 
 #[test]
 fn servoing_holds_the_line_for_40_ft_where_open_loop_wanders_off_it() {
-    let (servoed, looks) = run("missions/hallway-40ft.toml", "h40", "1/1");
+    let Run { truth: servoed, looks, corrections, levels } = run("missions/hallway-40ft.toml", "h40", "1/1");
     let travelled = servoed.last().expect("truth")[0];
     let held = worst(&servoed, 0.0, 40.0);
     println!("servoed: {:.2} ft travelled, at most {:.3} in off the line", travelled / FT, held / INCH);
@@ -67,8 +81,15 @@ fn servoing_holds_the_line_for_40_ft_where_open_loop_wanders_off_it() {
     // A look after each of the 20 increments, each finding the sign.
     assert_eq!(looks.len(), 20);
     assert!(looks.iter().all(|r| r.status == VisionStatus::Found as u32 && r.items[0].values[2] >= 0.9));
+    // Each look's correction is published (and drawn in run.rrd), after increments 1 to 20;
+    // the drift of an increment is well under 2 degrees.
+    assert_eq!(corrections.iter().map(|c| c.increment).collect::<Vec<_>>(), (1..=20).collect::<Vec<_>>());
+    assert!(corrections.iter().all(|c| c.heading_error_rad.abs() < 2f64.to_radians()), "{corrections:?}");
+    assert!(levels.contains(&(ServoLevel::Action as u32)), "action-level servoing reported");
 
-    let (open, looks) = run("missions/hallway-40ft-open.toml", "h40open", "1/1");
+    let Run { truth: open, looks, corrections, levels } =
+        run("missions/hallway-40ft-open.toml", "h40open", "1/1");
+    assert!(corrections.is_empty() && levels.iter().all(|&l| l == ServoLevel::None as u32));
     let at_18_20 = worst(&open, 18.0, 20.0);
     println!("open loop: {:.3} in off the line at 18-20 ft", at_18_20 / INCH);
     assert!(looks.is_empty(), "open loop looks at nothing");

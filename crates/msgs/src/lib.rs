@@ -5,11 +5,13 @@
 //! in names too (`world_from_robot`). Only `denning-bridge` knows the DRV's own units.
 //! This crate does no IO; it depends on iceoryx2's marker trait and derive only.
 
+mod executive;
 mod frame;
 mod payloads;
 pub mod topics;
 mod vision;
 
+pub use executive::*;
 pub use frame::{Encoding, FrameHeader};
 pub use iceoryx2_bb_derive_macros::ZeroCopySend;
 pub use iceoryx2_bb_elementary_traits::zero_copy_send::ZeroCopySend;

@@ -306,7 +306,8 @@ pub struct MissionStatus {
     /// Index of the step under way (== `step_count` when done).
     pub step: u32,
     pub step_count: u32,
-    pub reserved: u32,
+    /// [`crate::ServoLevel`] as its discriminant.
+    pub servo: u32,
     pub estimated: Pose2,
     pub goal: Pose2,
     /// Sonar rings, frames' detections and maps seen so far: proof the data flowed.

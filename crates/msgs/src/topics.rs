@@ -4,7 +4,7 @@ use core::marker::PhantomData;
 
 use crate::{
     Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, Progress,
-    SonarRaw, SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult,
+    ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult,
 };
 
 /// Queue sizing of a topic. Every process opening the topic uses the same numbers, so the
@@ -74,6 +74,7 @@ pub const UMS_MAP: Topic<UncertaintyMap> = Topic::new("ums/map", Qos::STATE);
 pub const VISION_SIGHTINGS: Topic<LandmarkSighting> = Topic::new("vision/sightings", Qos::STATE);
 pub const UMS_EXPECTATIONS: Topic<Expectation> = Topic::new("ums/expectations", Qos::STATE);
 pub const EXECUTIVE_STATUS: Topic<MissionStatus> = Topic::new("executive/status", Qos::STATE);
+pub const EXECUTIVE_SERVO: Topic<ServoCorrection> = Topic::new("executive/servo", Qos::STATE);
 pub const VISION_REQUESTS: Topic<VisionRequest> = Topic::new("vision/requests", Qos::STATE);
 pub const VISION_RESULTS: Topic<VisionResult> = Topic::new("vision/results", Qos::STATE);
 pub const CAMERA_FRAME: FrameTopic = FrameTopic { name: "camera/frame", qos: Qos::FRAMES };
@@ -100,6 +101,7 @@ pub const ALL: &[&str] = &[
     VISION_SIGHTINGS.name,
     UMS_EXPECTATIONS.name,
     EXECUTIVE_STATUS.name,
+    EXECUTIVE_SERVO.name,
     VISION_REQUESTS.name,
     VISION_RESULTS.name,
     CAMERA_FRAME.name,

@@ -111,6 +111,11 @@ impl Leg {
         Pose2 { x_m: self.line.x_m + d * c, y_m: self.line.y_m + d * s, heading_rad: self.line.heading_rad }
     }
 
+    /// Increments commanded so far.
+    pub fn increments_done(&self) -> usize {
+        self.done
+    }
+
     /// The first step.
     pub fn start(&mut self) -> LegStep {
         self.phase = Phase::Moving;

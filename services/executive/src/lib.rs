@@ -11,8 +11,8 @@ pub mod schemas;
 pub mod servo;
 
 use harvey_msgs::{
-    CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2, VisionAlgorithm,
-    VisionRequest, VisionResult, VisionStatus,
+    CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2, ServoCorrection,
+    ServoLevel, VisionAlgorithm, VisionRequest, VisionResult, VisionStatus,
 };
 use leg::{Leg, LegStep, ServoSetup};
 use mission::{Mission, Step};
@@ -23,6 +23,7 @@ pub enum Output {
     Command(MotionCommand),
     Status(MissionStatus),
     Look(VisionRequest),
+    Servo(ServoCorrection),
 }
 
 /// The executive's vision request ids start here (the vision workers' own standing requests
@@ -66,6 +67,7 @@ pub struct Executive {
     step_goal: Pose2,
     /// Primitives still to run to get back to `step_goal`, next last.
     recovery: Vec<(CommandKind, f64)>,
+    servo_seq: u64,
     /// Times a reflex interrupted the mission.
     pub preemptions: u32,
     /// The latest reflex command already dealt with (the vehicle reports it until ours is taken).
@@ -103,6 +105,7 @@ impl Executive {
             next_request: REQUEST_BASE,
             step_goal: Pose2::default(),
             recovery: Vec::new(),
+            servo_seq: 0,
             preemptions: 0,
             handled_reflex: 0,
             phase: Phase::Waiting,
@@ -229,9 +232,25 @@ impl Executive {
         let found = (VisionStatus::from_raw(r.status) == Some(VisionStatus::Found) && r.count > 0)
             .then(|| [f64::from(r.items[0].values[0]), f64::from(r.items[0].values[1])]);
         let Some(leg) = self.leg.as_mut() else { return Vec::new() };
+        let before = leg.corrections.len();
         let next = leg.on_seen(found);
         let (at, now) = (self.estimated, r.header.stamp_ns);
-        self.apply(step, next, at, now)
+        let mut out = Vec::new();
+        if let (Some(&(h, turn)), Some(px), Some(s)) = (leg.corrections.get(before), found, leg.servo) {
+            self.servo_seq += 1;
+            out.push(Output::Servo(ServoCorrection {
+                header: Header::new(self.servo_seq, now),
+                increment: leg.increments_done() as u32,
+                landmark_index: s.landmark_index,
+                found_px: px.map(|v| v as f32),
+                heading_error_rad: h,
+                correction_rad: turn,
+                offset_m: leg.offset_m,
+                shortfall_m: leg.shortfall_m,
+            }));
+        }
+        out.extend(self.apply(step, next, at, now));
+        out
     }
 
     /// One odometry message: advance the script; returns commands and the status to publish.
@@ -300,6 +319,16 @@ impl Executive {
         out
     }
 
+    /// Which level of servoing is steering now.
+    fn servo_level(&self) -> ServoLevel {
+        match self.phase {
+            Phase::Preempted { .. } => ServoLevel::Goal,
+            _ if !self.recovery.is_empty() => ServoLevel::Goal,
+            _ if self.leg.as_ref().is_some_and(|l| l.servo.is_some()) => ServoLevel::Action,
+            _ => ServoLevel::None,
+        }
+    }
+
     fn status(&mut self, stamp_ns: u64) -> MissionStatus {
         self.seq += 1;
         let step = match self.phase {
@@ -314,7 +343,7 @@ impl Executive {
             state: self.state() as u32,
             step: step as u32,
             step_count: self.mission.steps.len() as u32,
-            reserved: 0,
+            servo: self.servo_level() as u32,
             estimated: self.estimated,
             goal: self.goal,
             sonar_rings_seen: self.sonar_rings_seen,

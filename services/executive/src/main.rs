@@ -78,6 +78,7 @@ fn main() -> anyhow::Result<()> {
     let commands = bus.publisher(topics::VEHICLE_COMMAND)?;
     let status = bus.publisher(topics::EXECUTIVE_STATUS)?;
     let requests = bus.publisher(topics::VISION_REQUESTS)?;
+    let servo_pub = bus.publisher(topics::EXECUTIVE_SERVO)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps, &results])?;
@@ -120,6 +121,9 @@ fn main() -> anyhow::Result<()> {
                 }
                 Output::Status(s) => {
                     status.send(s)?;
+                }
+                Output::Servo(c) => {
+                    servo_pub.send(c)?;
                 }
             }
         }

@@ -2,8 +2,8 @@
 //! draw are left out of the view.
 
 use harvey_msgs::{
-    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, SonarRaw,
-    SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult,
+    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry,
+    ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult,
 };
 
 use crate::RecordError;
@@ -33,6 +33,7 @@ draw_with!(
     LandmarkSighting => sighting,
     MotionCommand => command,
     MissionStatus => status,
+    ServoCorrection => servo,
     Detections => detections,
     VisionResult => vision_result,
 );

@@ -5,8 +5,8 @@ use std::path::Path;
 
 use harvey_cdr::{Ros2Msg, decode, decode_image};
 use harvey_msgs::{
-    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, SonarRaw,
-    SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult, topics,
+    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry,
+    ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult, topics,
 };
 
 use crate::draw::Draw;
@@ -35,6 +35,7 @@ pub fn draw_recorded(w: &mut RrdWriter, topic: &str, data: &[u8]) -> Result<bool
         _ if t == topics::VISION_SIGHTINGS.name => draw::<LandmarkSighting>(w, data)?,
         _ if t == topics::UMS_EXPECTATIONS.name => draw::<Expectation>(w, data)?,
         _ if t == topics::EXECUTIVE_STATUS.name => draw::<MissionStatus>(w, data)?,
+        _ if t == topics::EXECUTIVE_SERVO.name => draw::<ServoCorrection>(w, data)?,
         _ if t == topics::VISION_REQUESTS.name => draw::<VisionRequest>(w, data)?,
         _ if t == topics::VISION_RESULTS.name => draw::<VisionResult>(w, data)?,
         _ if t == topics::CAMERA_FRAME.name => {

@@ -5,6 +5,7 @@
 //!
 //! The top-down view draws the world with y up: Rerun's 2D views put y down, so y is negated.
 
+mod executive;
 mod vision;
 use std::path::Path;
 
@@ -38,7 +39,7 @@ pub struct RrdWriter {
     rec: rerun::RecordingStream,
     path: String,
     pose: Option<[f64; 3]>,
-    last_state: Option<(u32, u32)>,
+    last_state: Option<(u32, u32, u32)>,
     /// The executive's current goal: the line the servo deviation is measured from.
     goal: Option<harvey_msgs::Pose2>,
     /// (focal, width, height) of the camera, to draw sightings' bearings on the image.
@@ -270,12 +271,18 @@ impl RrdWriter {
     /// The executive's status, logged when its state or step changes.
     pub fn status(&mut self, s: &MissionStatus) -> Result<(), RecordError> {
         self.goal = Some(s.goal);
-        if self.last_state == Some((s.state, s.step)) {
+        if self.last_state == Some((s.state, s.step, s.servo)) {
             return Ok(());
         }
-        self.last_state = Some((s.state, s.step));
+        self.last_state = Some((s.state, s.step, s.servo));
         self.at(s.header.stamp_ns);
-        let text = format!("mission state {} step {}/{}", s.state, s.step, s.step_count);
+        let servo = harvey_msgs::ServoLevel::from_raw(s.servo).map_or("?", |l| match l {
+            harvey_msgs::ServoLevel::None => "none",
+            harvey_msgs::ServoLevel::Action => "action-level",
+            harvey_msgs::ServoLevel::Plan => "plan-level",
+            harvey_msgs::ServoLevel::Goal => "goal-level",
+        });
+        let text = format!("mission state {} step {}/{}, servoing: {servo}", s.state, s.step, s.step_count);
         self.rec
             .log("log", &rerun::TextLog::new(text).with_level(rerun::TextLogLevel::INFO))
             .map_err(|e| self.err(e))
