@@ -1,7 +1,8 @@
 //! What the executive publishes about its own working besides its mission status: the servoing
-//! level it is at, and each action-level correction (`executive/servo`, 000 §5.5).
+//! level it is at, each action-level correction (`executive/servo`, 000 §5.5) and each
+//! plan-level pose refinement (`executive/pose`, 000 §5.6).
 
-use crate::{Header, Message, ZeroCopySend};
+use crate::{Header, Message, Pose2, ZeroCopySend};
 
 /// Which level of perceptual servoing is steering (`MissionStatus::servo`), 000 §4.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,3 +45,21 @@ pub struct ServoCorrection {
     pub shortfall_m: f64,
 }
 crate::payloads::message!(ServoCorrection);
+
+/// One plan-level pose refinement: the pose expected, the pose the landmark vertices gave.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/PoseFix")]
+pub struct PoseFix {
+    pub header: Header,
+    pub expected: Pose2,
+    pub refined: Pose2,
+    /// Vertices asked for, found by correlation, and kept by the refinement.
+    pub asked: u32,
+    pub found: u32,
+    pub kept: u32,
+    pub reserved: u32,
+    /// Root-mean-square image residual of the kept vertices (pixels).
+    pub rms_px: f64,
+}
+crate::payloads::message!(PoseFix);

@@ -6,10 +6,13 @@
 pub mod fsa;
 pub mod leg;
 pub mod mission;
+pub mod pose;
 pub mod recover;
+pub mod refining;
 pub mod schemas;
 pub mod servo;
 
+use harvey_msgs::PoseFix;
 use harvey_msgs::{
     CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2, ServoCorrection,
     ServoLevel, VisionAlgorithm, VisionRequest, VisionResult, VisionStatus,
@@ -24,6 +27,7 @@ pub enum Output {
     Status(MissionStatus),
     Look(VisionRequest),
     Servo(ServoCorrection),
+    Pose(PoseFix),
 }
 
 /// The executive's vision request ids start here (the vision workers' own standing requests
@@ -43,6 +47,13 @@ enum Phase {
     Looking {
         step: usize,
         request: u32,
+    },
+    /// Step `i` waits for the vision results of requests `first ..`, `received` so far.
+    Refining {
+        step: usize,
+        first: u32,
+        received: u32,
+        since_ns: u64,
     },
     /// A sonar reflex took the vehicle during step `i`; it last moved at `since_ns`.
     Preempted {
@@ -68,6 +79,14 @@ pub struct Executive {
     /// Primitives still to run to get back to `step_goal`, next last.
     recovery: Vec<(CommandKind, f64)>,
     servo_seq: u64,
+    /// Plan-level servoing: what it needs, what the current look found, the latest odometry,
+    /// and the belief `(odometry then, refined pose then)` since the last refinement.
+    refine: Option<refining::RefineSetup>,
+    looks: Vec<Option<[f64; 2]>>,
+    odometry: Pose2,
+    belief: Option<(Pose2, Pose2)>,
+    /// Every refinement: (expected, refined).
+    pub refinements: Vec<(Pose2, Pose2)>,
     /// Times a reflex interrupted the mission.
     pub preemptions: u32,
     /// The latest reflex command already dealt with (the vehicle reports it until ours is taken).
@@ -96,6 +115,12 @@ pub fn goal_of(start: Pose2, steps: &[Step]) -> Pose2 {
 
 impl Executive {
     /// `servo[i]` says how step `i` servos (it must say so for every `servo_landmark` step).
+    /// With plan-level servoing: what `refine_pose` steps need.
+    pub fn with_refine(mut self, setup: refining::RefineSetup) -> Self {
+        self.refine = Some(setup);
+        self
+    }
+
     pub fn new(mission: Mission, servo: Vec<Option<ServoSetup>>) -> Self {
         Self {
             mission,
@@ -106,6 +131,11 @@ impl Executive {
             step_goal: Pose2::default(),
             recovery: Vec::new(),
             servo_seq: 0,
+            refine: None,
+            looks: Vec::new(),
+            odometry: Pose2::default(),
+            belief: None,
+            refinements: Vec::new(),
             preemptions: 0,
             handled_reflex: 0,
             phase: Phase::Waiting,
@@ -145,6 +175,9 @@ impl Executive {
     fn begin(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
         self.step_goal = goal_of(at, std::slice::from_ref(&self.mission.steps[step]));
         let s: &Step = &self.mission.steps[step];
+        if s.refine_pose {
+            return self.begin_refine(step, now);
+        }
         match (s.move_m, s.turn_deg, s.increment_m) {
             (Some(d), _, Some(inc)) => {
                 let servo = self.servo.get(step).copied().flatten();
@@ -225,6 +258,9 @@ impl Executive {
 
     /// A vision result: the answer to the leg's look, if it is the one awaited.
     pub fn on_vision(&mut self, r: &VisionResult) -> Vec<Output> {
+        if matches!(self.phase, Phase::Refining { .. }) {
+            return self.on_refine_result(r);
+        }
         let Phase::Looking { step, request } = self.phase else { return Vec::new() };
         if r.request_id != request {
             return Vec::new();
@@ -256,13 +292,15 @@ impl Executive {
     /// One odometry message: advance the script; returns commands and the status to publish.
     pub fn on_odometry(&mut self, o: &Odometry) -> Vec<Output> {
         let now = o.header.stamp_ns;
-        self.estimated = o.world_from_robot;
+        self.odometry = o.world_from_robot;
+        self.estimated = self.believed();
+        let at = self.estimated;
         let mut out = Vec::new();
         match self.phase {
             Phase::Waiting => {
                 self.start_ns = now;
-                self.goal = goal_of(o.world_from_robot, &self.mission.steps);
-                out = self.begin(0, o.world_from_robot, now);
+                self.goal = goal_of(at, &self.mission.steps);
+                out = self.begin(0, at, now);
             }
             Phase::Executing { step, .. } | Phase::Looking { step, .. }
                 if recover::is_reflex(o.command.command_id)
@@ -284,26 +322,29 @@ impl Executive {
                 if fresh || o.moving != 0 || o.command_accepted == 0 {
                     self.phase = Phase::Preempted { step, since_ns: now };
                 } else if now.saturating_sub(since_ns) >= recover::QUIET_NS {
-                    self.recovery = recover::back_to(o.world_from_robot, self.step_goal);
+                    self.recovery = recover::back_to(at, self.step_goal);
                     self.recovery.reverse();
-                    out = self.resume(step, o.world_from_robot, now);
+                    out = self.resume(step, at, now);
                 }
             }
             Phase::Executing { step, id } => {
                 let finished = o.command.command_id == id && o.command_accepted == 1 && o.moving == 0;
                 if finished && !self.recovery.is_empty() {
-                    out = self.resume(step, o.world_from_robot, now);
+                    out = self.resume(step, at, now);
                 } else if finished {
                     out = match self.leg.as_mut() {
                         Some(leg) => {
                             let next = leg.on_done();
-                            self.apply(step, next, o.world_from_robot, now)
+                            self.apply(step, next, at, now)
                         }
-                        None => self.step_done(step, o.world_from_robot, now),
+                        None => self.step_done(step, at, now),
                     };
                 }
             }
-            Phase::Looking { .. } | Phase::Done(_) => {}
+            Phase::Refining { step, since_ns, .. } if now.saturating_sub(since_ns) > refining::WAIT_NS => {
+                out = self.finish_refine(step, now);
+            }
+            Phase::Looking { .. } | Phase::Refining { .. } | Phase::Done(_) => {}
         }
         let running = !matches!(self.phase, Phase::Done(_));
         if running && now.saturating_sub(self.start_ns) as f64 > self.mission.timeout_s * 1e9 {
@@ -323,6 +364,7 @@ impl Executive {
     fn servo_level(&self) -> ServoLevel {
         match self.phase {
             Phase::Preempted { .. } => ServoLevel::Goal,
+            Phase::Refining { .. } => ServoLevel::Plan,
             _ if !self.recovery.is_empty() => ServoLevel::Goal,
             _ if self.leg.as_ref().is_some_and(|l| l.servo.is_some()) => ServoLevel::Action,
             _ => ServoLevel::None,
@@ -333,9 +375,10 @@ impl Executive {
         self.seq += 1;
         let step = match self.phase {
             Phase::Waiting => 0,
-            Phase::Executing { step, .. } | Phase::Looking { step, .. } | Phase::Preempted { step, .. } => {
-                step
-            }
+            Phase::Executing { step, .. }
+            | Phase::Looking { step, .. }
+            | Phase::Refining { step, .. }
+            | Phase::Preempted { step, .. } => step,
             Phase::Done(_) => self.mission.steps.len(),
         };
         MissionStatus {
@@ -362,6 +405,7 @@ mod tests {
             description: "t".into(),
             timeout_s,
             servo: None,
+            refine: None,
             steps: vec![
                 Step { move_m: Some(2.0), ..Step::default() },
                 Step { turn_deg: Some(90.0), ..Step::default() },

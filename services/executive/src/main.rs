@@ -9,6 +9,8 @@ use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_executive::leg::ServoSetup;
 use harvey_executive::mission::Mission;
+use harvey_executive::pose::{PinholeCamera, RefineParams};
+use harvey_executive::refining::RefineSetup;
 use harvey_executive::servo::ServoParams;
 use harvey_executive::{Executive, Output, mission};
 use harvey_msgs::{MissionState, topics};
@@ -59,6 +61,44 @@ fn servo_setups(m: &Mission, world: Option<&World>) -> anyhow::Result<Vec<Option
         .collect()
 }
 
+/// What plan-level servoing needs: each vertex anchored on the nearest landmark (the vision
+/// request names a landmark and an offset from its point), and the camera.
+fn refine_setup(m: &Mission, world: Option<&World>) -> anyhow::Result<Option<RefineSetup>> {
+    let Some(r) = &m.refine else { return Ok(None) };
+    let w = world.context("[mission.refine] needs --world")?;
+    let vertices = r
+        .vertices_m
+        .iter()
+        .map(|&v| {
+            let dist = |p: [f64; 3]| (0..3).map(|k| (p[k] - v[k]).powi(2)).sum::<f64>();
+            let (i, l) = w
+                .landmarks
+                .iter()
+                .enumerate()
+                .min_by(|a, b| dist(a.1.point()).total_cmp(&dist(b.1.point())))
+                .context("the world has no landmark to anchor vertices on")?;
+            let p = l.point();
+            Ok((i as u32, [v[0] - p[0], v[1] - p[1], v[2] - p[2]], v))
+        })
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let c = &w.camera;
+    Ok(Some(RefineSetup {
+        vertices,
+        camera: PinholeCamera {
+            focal_px: c.focal_for(c.width_px),
+            centre_px: [f64::from(c.width_px) / 2.0, f64::from(c.height_px) / 2.0],
+            height_m: c.height_m,
+        },
+        params: RefineParams {
+            prior_sd: [r.prior_sd[0], r.prior_sd[1], r.prior_sd[2].to_radians()],
+            image_sd_px: 0.5,
+            gate_px: r.gate_px,
+        },
+        template_px: r.template_px,
+        min_score: r.min_score,
+    }))
+}
+
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
@@ -67,6 +107,7 @@ fn main() -> anyhow::Result<()> {
     let mission = mission::parse(&text, &args.mission.display().to_string()).map_err(anyhow::Error::msg)?;
     let world = args.world.as_deref().map(World::load).transpose()?;
     let servo = servo_setups(&mission, world.as_ref())?;
+    let refine = refine_setup(&mission, world.as_ref())?;
     tracing::info!(description = %mission.description, steps = mission.steps.len(), "mission loaded");
 
     let bus = Bus::join("executive")?;
@@ -79,12 +120,16 @@ fn main() -> anyhow::Result<()> {
     let status = bus.publisher(topics::EXECUTIVE_STATUS)?;
     let requests = bus.publisher(topics::VISION_REQUESTS)?;
     let servo_pub = bus.publisher(topics::EXECUTIVE_SERVO)?;
+    let pose_pub = bus.publisher(topics::EXECUTIVE_POSE)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps, &results])?;
     harvey_runtime::notify_ready()?;
 
     let mut exec = Executive::new(mission, servo);
+    if let Some(setup) = refine {
+        exec = exec.with_refine(setup);
+    }
     let (mut odos, mut seen) = (Vec::new(), Vec::new());
     let mut out = Vec::new();
     while exec.state() == MissionState::Running {
@@ -124,6 +169,9 @@ fn main() -> anyhow::Result<()> {
                 }
                 Output::Servo(c) => {
                     servo_pub.send(c)?;
+                }
+                Output::Pose(p) => {
+                    pose_pub.send(p)?;
                 }
             }
         }

@@ -18,6 +18,27 @@ pub struct Step {
     /// …at this offset from the landmark's point (a vertex where reflectances meet, 000 §5.2).
     #[serde(default)]
     pub servo_vertex_m: [f64; 3],
+    /// Plan-level servoing (000 §5.6): find the `[mission.refine]` vertices and refine the
+    /// robot's pose from them, instead of moving.
+    #[serde(default)]
+    pub refine_pose: bool,
+    /// Before refining, believe the robot this far (m, world x and y) from where odometry says:
+    /// an expected pose off target, as in 000 Table 1.
+    pub belief_offset_m: Option<[f64; 2]>,
+}
+
+/// Plan-level servoing settings (`[mission.refine]`).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Refine {
+    /// Landmark vertices (world, m) to find by correlation (000 §5.2: where reflectances meet).
+    pub vertices_m: Vec<[f64; 3]>,
+    pub template_px: u32,
+    pub min_score: f64,
+    /// How well the expected pose is known: x, y (m) and heading (degrees).
+    pub prior_sd: [f64; 3],
+    /// A vertex further than this (pixels) from where the refined pose puts it is dropped.
+    pub gate_px: f64,
 }
 
 /// Action-level servoing settings (`[mission.servo]`).
@@ -48,6 +69,7 @@ pub struct Mission {
     #[serde(rename = "step")]
     pub steps: Vec<Step>,
     pub servo: Option<Servo>,
+    pub refine: Option<Refine>,
 }
 
 #[derive(Deserialize)]
@@ -69,11 +91,13 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
         return Err(format!("{file}: the mission has no [[mission.step]]"));
     }
     for (i, s) in m.steps.iter().enumerate() {
-        match (s.move_m, s.turn_deg) {
-            (Some(v), None) | (None, Some(v)) if v.is_finite() => {}
+        match (s.move_m, s.turn_deg, s.refine_pose) {
+            (Some(v), None, false) | (None, Some(v), false) if v.is_finite() => {}
+            (None, None, true) if m.refine.as_ref().is_some_and(|r| r.vertices_m.len() >= 2) => {}
             _ => {
                 return Err(format!(
-                    "{file}: mission.step[{i}] needs exactly one finite `move_m` or `turn_deg`"
+                    "{file}: mission.step[{i}] needs exactly one finite `move_m` or `turn_deg`, or \
+                     `refine_pose` with two or more [mission.refine] vertices_m"
                 ));
             }
         }

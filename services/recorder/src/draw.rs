@@ -34,6 +34,7 @@ draw_with!(
     MotionCommand => command,
     MissionStatus => status,
     ServoCorrection => servo,
+    harvey_msgs::PoseFix => pose_fix,
     Detections => detections,
     VisionResult => vision_result,
 );
