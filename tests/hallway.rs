@@ -19,19 +19,14 @@ struct Run {
 }
 
 fn run(mission: &str, tag: &str, steps: &str) -> Run {
-    let prefix = common::unique_prefix(tag);
-    let dir = common::scratch(tag);
-    let out =
-        common::harvey(&["run", mission, "--prefix", &prefix, "--run-dir", dir.to_str().expect("utf8")])
-            .output()
-            .expect("runs");
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let out = common::run_mission(mission, tag);
     assert!(
-        out.status.success() && stdout.contains(&format!("goal reached ({steps} steps)")),
-        "{mission}: {stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
+        out.status.success() && out.stdout.contains(&format!("goal reached ({steps} steps)")),
+        "{mission}: {}\n{}",
+        out.stdout,
+        out.stderr
     );
-    let bytes = std::fs::read(dir.join("run.mcap")).expect("recording");
+    let bytes = out.mcap;
     let (mut truth, mut looks, mut corrections, mut levels) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for m in mcap::MessageStream::new(&bytes).expect("mcap") {
@@ -56,7 +51,6 @@ fn run(mission: &str, tag: &str, steps: &str) -> Run {
             _ => {}
         }
     }
-    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
     Run { truth, looks, corrections, levels }
 }
 

@@ -30,20 +30,8 @@ fn run(launch: &std::path::Path, tag: &str) -> Run {
     let text = std::fs::read_to_string(launch).expect("launch file");
     let movers = parse_movers(&text, "panic-avoid").expect("movers");
     let cart = movers.first().expect("a cart");
-    let prefix = common::unique_prefix(tag);
-    let dir = common::scratch(tag);
-    let out = common::harvey(&[
-        "run",
-        launch.to_str().expect("utf8"),
-        "--prefix",
-        &prefix,
-        "--run-dir",
-        dir.to_str().expect("utf8"),
-    ])
-    .output()
-    .expect("runs");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let bytes = std::fs::read(dir.join("run.mcap")).expect("recording");
+    let out = common::run_mission(launch.to_str().expect("utf8"), tag);
+    let bytes = out.mcap;
     let (mut closest_m, mut reflex) = (f64::MAX, Vec::new());
     for m in mcap::MessageStream::new(&bytes).expect("mcap") {
         let m = m.expect("message");
@@ -62,8 +50,11 @@ fn run(launch: &std::path::Path, tag: &str) -> Run {
             _ => {}
         }
     }
-    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
-    Run { reached: out.status.success() && stdout.contains("goal reached (1/1 steps)"), closest_m, reflex }
+    Run {
+        reached: out.status.success() && out.stdout.contains("goal reached (1/1 steps)"),
+        closest_m,
+        reflex,
+    }
 }
 
 #[test]

@@ -11,21 +11,9 @@ const INCH: f64 = 0.0254;
 
 #[test]
 fn expected_poses_inches_off_are_refined_to_within_an_inch_and_a_half() {
-    let prefix = common::unique_prefix("prefine");
-    let dir = common::scratch("prefine");
-    let out = common::harvey(&[
-        "run",
-        "missions/pose-refine.toml",
-        "--prefix",
-        &prefix,
-        "--run-dir",
-        dir.to_str().expect("utf8"),
-    ])
-    .output()
-    .expect("runs");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success() && stdout.contains("goal reached (4/4 steps)"), "{stdout}");
-    let bytes = std::fs::read(dir.join("run.mcap")).expect("recording");
+    let out = common::run_mission("missions/pose-refine.toml", "prefine");
+    assert!(out.status.success() && out.stdout.contains("goal reached (4/4 steps)"), "{}", out.stdout);
+    let bytes = out.mcap;
     let (mut fixes, mut truth) = (Vec::new(), None);
     for m in mcap::MessageStream::new(&bytes).expect("mcap") {
         let m = m.expect("message");
@@ -37,7 +25,6 @@ fn expected_poses_inches_off_are_refined_to_within_an_inch_and_a_half() {
             _ => {}
         }
     }
-    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
     let t = truth.expect("truth");
     assert_eq!(fixes.len(), 4, "one refinement per step");
     let off = |p: harvey_msgs::Pose2| (p.x_m - t.x_m).hypot(p.y_m - t.y_m) / INCH;

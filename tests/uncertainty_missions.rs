@@ -8,19 +8,14 @@ use harvey_msgs::{TruePose, UncertaintyMap};
 
 /// Runs a mission; returns its maps (with the truth at each map's stamp checked inside).
 fn run(mission: &str, tag: &str) -> Vec<UncertaintyMap> {
-    let prefix = common::unique_prefix(tag);
-    let dir = common::scratch(tag);
-    let out =
-        common::harvey(&["run", mission, "--prefix", &prefix, "--run-dir", dir.to_str().expect("utf8")])
-            .output()
-            .expect("runs");
-    let stdout = String::from_utf8_lossy(&out.stdout);
+    let out = common::run_mission(mission, tag);
     assert!(
-        out.status.success() && stdout.contains("goal reached (10/10 steps)"),
-        "{mission}: {stdout}\n{}",
-        String::from_utf8_lossy(&out.stderr)
+        out.status.success() && out.stdout.contains("goal reached (10/10 steps)"),
+        "{mission}: {}\n{}",
+        out.stdout,
+        out.stderr
     );
-    let bytes = std::fs::read(dir.join("run.mcap")).expect("recording");
+    let bytes = out.mcap;
     let (mut maps, mut truth) = (Vec::new(), Vec::new());
     for m in mcap::MessageStream::new(&bytes).expect("mcap") {
         let m = m.expect("message");
@@ -40,7 +35,6 @@ fn run(mission: &str, tag: &str) -> Vec<UncertaintyMap> {
             );
         }
     }
-    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
     maps
 }
 

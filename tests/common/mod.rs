@@ -97,6 +97,33 @@ pub fn harvey(args: &[&str]) -> Command {
     c
 }
 
+/// A mission run by `harvey run` under its own bus prefix and run folder.
+#[allow(dead_code)] // not every test binary runs missions
+pub struct MissionRun {
+    pub status: std::process::ExitStatus,
+    pub stdout: String,
+    pub stderr: String,
+    /// The recording's bytes.
+    pub mcap: Vec<u8>,
+}
+
+/// Runs `mission` (a path from the repository root, or absolute); checks nothing of the
+/// mission, only that its shared memory is gone afterwards.
+#[allow(dead_code)]
+pub fn run_mission(mission: &str, tag: &str) -> MissionRun {
+    let (prefix, dir) = (unique_prefix(tag), scratch(tag));
+    let out = harvey(&["run", mission, "--prefix", &prefix, "--run-dir", dir.to_str().expect("utf8")])
+        .output()
+        .expect("runs");
+    assert_eq!(shm_leftovers(&prefix), Vec::<String>::new());
+    MissionRun {
+        status: out.status,
+        stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
+        stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
+        mcap: std::fs::read(dir.join("run.mcap")).unwrap_or_default(),
+    }
+}
+
 /// Whether the map holds a pose: inside its convex polygon (with `tol`) and its heading wedge.
 pub fn holds(m: &harvey_msgs::UncertaintyMap, x: f64, y: f64, th: f64, tol: f64) -> bool {
     let n = m.vertex_count as usize;

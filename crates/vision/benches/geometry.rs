@@ -116,20 +116,6 @@ pub fn bench_depth(world: &World, first: &GrayBuf, size: &str, rows: &mut Vec<Ro
     }
 }
 
-/// The dock model of 004's docking tests: a 2 x 1 frame with a centre post.
-fn dock() -> DockModel {
-    let s = |a: [f32; 2], b: [f32; 2]| [a, b];
-    DockModel {
-        segments: vec![
-            s([-1.0, -0.5], [1.0, -0.5]),
-            s([-1.0, 0.5], [1.0, 0.5]),
-            s([-1.0, -0.5], [-1.0, 0.5]),
-            s([1.0, -0.5], [1.0, 0.5]),
-            s([0.0, -0.5], [0.0, 0.5]),
-        ],
-    }
-}
-
 /// The frame's lines in each scope (the Hough and path rows time what comes after the finder).
 fn lines(img: &GrayBuf, side: usize) -> Vec<(String, Rect, Vec<Line>)> {
     let mut flf = Flf::default();
@@ -145,7 +131,7 @@ fn lines(img: &GrayBuf, side: usize) -> Vec<(String, Rect, Vec<Line>)> {
 pub fn bench_hough(img: &GrayBuf, size: &str, rows: &mut Vec<Row>) {
     let hyps: Vec<Hypothesis> =
         [30.0, 35.0, 40.0, 45.0, 50.0].iter().map(|&scale| Hypothesis { scale, rotation: 0.0 }).collect();
-    let model = dock();
+    let model = DockModel::frame_with_post();
     let dims = [img.width, img.height];
     for (scope, win, lines) in lines(img, 192) {
         rows.push(measure(

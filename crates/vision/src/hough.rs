@@ -11,6 +11,23 @@ pub struct DockModel {
     pub segments: Vec<[[f32; 2]; 2]>,
 }
 
+impl DockModel {
+    /// A dock front as a 2 x 1 frame with a centre post, reference point at its centre (the
+    /// shape the docking tests and the bench use).
+    pub fn frame_with_post() -> Self {
+        let s = |a: [f32; 2], b: [f32; 2]| [a, b];
+        Self {
+            segments: vec![
+                s([-1.0, -0.5], [1.0, -0.5]),
+                s([-1.0, 0.5], [1.0, 0.5]),
+                s([-1.0, -0.5], [-1.0, 0.5]),
+                s([1.0, -0.5], [1.0, 0.5]),
+                s([0.0, -0.5], [0.0, 0.5]),
+            ],
+        }
+    }
+}
+
 /// One scale and orientation the dock may appear at (from the spatial uncertainty).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Hypothesis {
@@ -166,18 +183,8 @@ mod tests {
         }
     }
 
-    /// A dock front: a 2 x 1 frame with a centre post, reference point at its centre.
     fn dock() -> DockModel {
-        let s = |a: [f32; 2], b: [f32; 2]| [a, b];
-        DockModel {
-            segments: vec![
-                s([-1.0, -0.5], [1.0, -0.5]),
-                s([-1.0, 0.5], [1.0, 0.5]),
-                s([-1.0, -0.5], [-1.0, 0.5]),
-                s([1.0, -0.5], [1.0, 0.5]),
-                s([0.0, -0.5], [0.0, 0.5]),
-            ],
-        }
+        DockModel::frame_with_post()
     }
 
     /// The dock seen at `scale`, `rotation` about `at`, each segment broken in two with a gap and
