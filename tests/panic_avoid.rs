@@ -1,11 +1,12 @@
 //! 001 §6.2, panic-avoid, as a mission: a cart rolls up the hall at the robot driving down it.
 //! The sonar's reflex stops the robot, turns it a right angle away from the cart and dashes it
 //! aside, holds it still while the cart goes by, and the executive then gets back to its goal.
-//! With the reflex turned off (the control), the panic-stop freezes the robot in the cart's way.
+//! With the reflex turned off (the control), the panic-stop freezes the robot in the cart's way
+//! and the cart would hit it.
 
 mod common;
 
-use harvey_msgs::{CommandKind, MotionCommand, TruePose};
+use harvey_msgs::{CommandKind, MotionCommand, PANIC_STOP_IDS, REFLEX_ID_BIT, TruePose};
 use harvey_world::{Mover, parse_movers};
 
 /// The robot's radius (its sonar ring, `worlds/hallway.toml`).
@@ -15,7 +16,9 @@ struct Run {
     reached: bool,
     /// Closest distance from the robot's centre to the cart's footprint.
     closest_m: f64,
+    /// The panic-avoid's commands, and how many panic-stops were sent.
     reflex: Vec<MotionCommand>,
+    panic_stops: usize,
 }
 
 fn distance_to(cart: &Mover, t_s: f64, p: [f64; 2]) -> f64 {
@@ -32,7 +35,7 @@ fn run(launch: &std::path::Path, tag: &str) -> Run {
     let cart = movers.first().expect("a cart");
     let out = common::run_mission(launch.to_str().expect("utf8"), tag);
     let bytes = out.mcap;
-    let (mut closest_m, mut reflex) = (f64::MAX, Vec::new());
+    let (mut closest_m, mut reflex, mut panic_stops) = (f64::MAX, Vec::new(), 0);
     for m in mcap::MessageStream::new(&bytes).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
@@ -43,8 +46,10 @@ fn run(launch: &std::path::Path, tag: &str) -> Run {
             }
             "/vehicle/reflex" => {
                 let c = harvey_cdr::decode::<MotionCommand>(&m.data).expect("command");
-                if c.command_id & 0x8000_0000 != 0 {
-                    reflex.push(c);
+                match c.command_id & PANIC_STOP_IDS {
+                    PANIC_STOP_IDS => panic_stops += 1,
+                    REFLEX_ID_BIT => reflex.push(c),
+                    _ => panic!("a reflex command without a reflex id: {c:?}"),
                 }
             }
             _ => {}
@@ -54,6 +59,7 @@ fn run(launch: &std::path::Path, tag: &str) -> Run {
         reached: out.status.success() && out.stdout.contains("goal reached (1/1 steps)"),
         closest_m,
         reflex,
+        panic_stops,
     }
 }
 
@@ -87,7 +93,8 @@ fn the_robot_gets_out_of_the_carts_way_and_then_to_its_goal() {
     std::fs::write(&control, off).expect("control launch file");
     let frozen = run(&control, "pavoid-off");
     println!("without: closest {:.3} m", frozen.closest_m);
-    assert!(frozen.reflex.is_empty());
+    assert!(frozen.reflex.is_empty() && frozen.panic_stops > 0, "only the panic-stop acts");
+    // Frozen in the cart's way, the robot would be hit (the simulator lets the cart pass through;
+    // the executive then carries on once the panic-stop lets go).
     assert!(frozen.closest_m < RADIUS_M, "the cart would hit the robot: {} m", frozen.closest_m);
-    assert!(!frozen.reached, "frozen by the panic-stop, the robot misses its goal");
 }

@@ -142,6 +142,12 @@ pub struct MotionCommand {
 }
 message!(MotionCommand);
 
+/// Command ids with this bit set are the sonar reflexes' (`vehicle/reflex`): the executive
+/// knows by it that a reflex has taken the vehicle.
+pub const REFLEX_ID_BIT: u32 = 0x8000_0000;
+/// The panic-stop's ids have the two top bits set; the panic-avoid's only the top one.
+pub const PANIC_STOP_IDS: u32 = 0xC000_0000;
+
 impl MotionCommand {
     pub fn kind(&self) -> Option<CommandKind> {
         CommandKind::from_raw(self.kind)

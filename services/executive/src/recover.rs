@@ -5,8 +5,7 @@
 
 use harvey_msgs::{CommandKind, Pose2};
 
-/// Command ids with this bit set are the sonar reflexes' (`harvey_sonar::avoid`).
-pub const REFLEX_ID_BIT: u32 = 0x8000_0000;
+use harvey_msgs::REFLEX_ID_BIT;
 
 /// Whether the vehicle's current command is a reflex's.
 pub fn is_reflex(command_id: u32) -> bool {

@@ -11,7 +11,7 @@ use crate::approach::{Approach, ApproachParams};
 use crate::bearing_rad;
 
 /// Command ids of the reflex: the top bit set, so they never clash with the executive's.
-const ID_BASE: u32 = 0x8000_0000;
+const ID_BASE: u32 = harvey_msgs::REFLEX_ID_BIT;
 
 /// Settings (the paper gives the right-angle turn; the rest are this system's choices).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -120,7 +120,8 @@ impl PanicAvoid {
         distance_m: f64,
         angle_rad: f64,
     ) -> MotionCommand {
-        self.next_id = self.next_id.wrapping_add(1) | ID_BASE;
+        // Top bit set, second clear: below the panic-stop's ids.
+        self.next_id = (self.next_id.wrapping_add(1) & !harvey_msgs::PANIC_STOP_IDS) | ID_BASE;
         MotionCommand {
             header: Header::new(u64::from(self.next_id & !ID_BASE), stamp_ns),
             kind: kind as u32,

@@ -5,6 +5,7 @@
 pub mod approach;
 pub mod avoid;
 
+use harvey_msgs::PANIC_STOP_IDS;
 use harvey_msgs::{CommandKind, Header, MotionCommand, SONAR_BANK_SIZE, SONAR_SENSORS, SonarRaw, SonarRing};
 
 /// Sensors whose axis lies within this angle of straight ahead watch for the panic-stop.
@@ -74,6 +75,8 @@ impl SonarRingBuilder {
             header: self.ring.header,
             kind: CommandKind::Stop as u32,
             urgent: 1,
+            // A reflex's id (top bit; the panic-avoid counts below `PANIC_STOP_IDS`), never 0.
+            command_id: PANIC_STOP_IDS | (self.seq as u32 & !PANIC_STOP_IDS),
             ..MotionCommand::default()
         });
         Ok(Update { ring: self.ring, panic_stop })
@@ -115,6 +118,7 @@ mod tests {
         let u = b.on_bank(&bank(0, ranges, 10)).expect("valid");
         let stop = u.panic_stop.expect("panic-stop fires");
         assert_eq!((stop.kind, stop.urgent), (CommandKind::Stop as u32, 1));
+        assert_eq!(stop.command_id & PANIC_STOP_IDS, PANIC_STOP_IDS, "a reflex's id, not 0");
         assert!(b.panicking());
         // Sensor 9 (135 degrees) that close does not stop a robot moving forward.
         let mut side = [5.0; 8];
