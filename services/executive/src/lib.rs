@@ -6,6 +6,7 @@
 pub mod fsa;
 pub mod leg;
 pub mod mission;
+pub mod plan;
 pub mod pose;
 pub mod recover;
 pub mod refining;
