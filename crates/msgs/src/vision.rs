@@ -105,6 +105,33 @@ pub struct VisionRequest {
 }
 crate::payloads::message!(VisionRequest);
 
+impl VisionRequest {
+    /// A one-off [`VisionAlgorithm::Correlate`] request over the whole frame: landmark
+    /// `landmark_index`'s point moved by `offset_m`, its template `template_px` square, ray-traced
+    /// from `expected`; found when it scores `min_score`.
+    pub fn correlate(
+        request_id: u32,
+        stamp_ns: u64,
+        landmark_index: u32,
+        expected: Pose2,
+        offset_m: [f64; 3],
+        template_px: u32,
+        min_score: f64,
+    ) -> Self {
+        let o = offset_m.map(|v| v as f32);
+        Self {
+            header: Header::new(u64::from(request_id), stamp_ns),
+            request_id,
+            algorithm: VisionAlgorithm::Correlate as u32,
+            standing: 0,
+            landmark_index,
+            expected,
+            window_px: [0.0; 4],
+            params: [template_px as f32, min_score as f32, o[0], o[1], o[2], 0.0, 0.0, 0.0],
+        }
+    }
+}
+
 /// One found thing; the algorithm says what the six numbers are.
 #[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
 #[repr(C)]

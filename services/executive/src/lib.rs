@@ -16,7 +16,7 @@ pub mod servo;
 use harvey_msgs::PoseFix;
 use harvey_msgs::{
     CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2, ServoCorrection,
-    ServoLevel, VisionAlgorithm, VisionRequest, VisionResult, VisionStatus,
+    ServoLevel, VisionRequest, VisionResult, VisionStatus,
 };
 use leg::{Leg, LegStep, ServoSetup};
 use mission::{Mission, Step};
@@ -86,8 +86,6 @@ pub struct Executive {
     looks: Vec<Option<[f64; 2]>>,
     odometry: Pose2,
     belief: Option<(Pose2, Pose2)>,
-    /// Every refinement: (expected, refined).
-    pub refinements: Vec<(Pose2, Pose2)>,
     /// Times a reflex interrupted the mission.
     pub preemptions: u32,
     /// The latest reflex command already dealt with (the vehicle reports it until ours is taken).
@@ -136,7 +134,6 @@ impl Executive {
             looks: Vec::new(),
             odometry: Pose2::default(),
             belief: None,
-            refinements: Vec::new(),
             preemptions: 0,
             handled_reflex: 0,
             phase: Phase::Waiting,
@@ -217,17 +214,15 @@ impl Executive {
                 let request = self.next_request;
                 self.next_request += 1;
                 self.phase = Phase::Looking { step, request };
-                let o = s.offset.map(|v| v as f32);
-                vec![Output::Look(VisionRequest {
-                    header: Header::new(u64::from(request), now),
-                    request_id: request,
-                    algorithm: VisionAlgorithm::Correlate as u32,
-                    standing: 0,
-                    landmark_index: s.landmark_index,
+                vec![Output::Look(VisionRequest::correlate(
+                    request,
+                    now,
+                    s.landmark_index,
                     expected,
-                    window_px: [0.0; 4],
-                    params: [sv.template_px as f32, sv.min_score as f32, o[0], o[1], o[2], 0.0, 0.0, 0.0],
-                })]
+                    s.offset,
+                    sv.template_px,
+                    sv.min_score,
+                ))]
             }
             LegStep::Done => {
                 if let Some(l) = self.leg.take() {

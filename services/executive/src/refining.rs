@@ -3,7 +3,7 @@
 //! matches (`pose.rs`), and from then on the executive believes the refined pose (odometry's
 //! later motion is composed onto it), so that the next subgoal starts from where the robot is.
 
-use harvey_msgs::{Header, Pose2, PoseFix, VisionAlgorithm, VisionRequest, VisionResult, VisionStatus};
+use harvey_msgs::{Header, Pose2, PoseFix, VisionRequest, VisionResult, VisionStatus};
 
 use crate::pose::{PinholeCamera, RefineParams, VertexMatch, refine};
 use crate::{Executive, Output, Phase};
@@ -70,27 +70,17 @@ impl Executive {
             .vertices
             .iter()
             .enumerate()
-            .map(|(k, &(landmark_index, o, _))| {
+            .map(|(k, &(landmark_index, offset, _))| {
                 let id = first + k as u32;
-                Output::Look(VisionRequest {
-                    header: Header::new(u64::from(id), now),
-                    request_id: id,
-                    algorithm: VisionAlgorithm::Correlate as u32,
-                    standing: 0,
+                Output::Look(VisionRequest::correlate(
+                    id,
+                    now,
                     landmark_index,
                     expected,
-                    window_px: [0.0; 4],
-                    params: [
-                        setup.template_px as f32,
-                        setup.min_score as f32,
-                        o[0] as f32,
-                        o[1] as f32,
-                        o[2] as f32,
-                        0.0,
-                        0.0,
-                        0.0,
-                    ],
-                })
+                    offset,
+                    setup.template_px,
+                    setup.min_score,
+                ))
             })
             .collect()
     }
@@ -140,7 +130,6 @@ impl Executive {
                 );
                 self.belief = Some((self.odometry, done.pose));
                 self.estimated = done.pose;
-                self.refinements.push((expected, done.pose));
                 self.servo_seq += 1;
                 out.push(Output::Pose(PoseFix {
                     header: Header::new(self.servo_seq, now),

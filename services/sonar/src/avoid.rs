@@ -147,13 +147,13 @@ impl PanicAvoid {
             Phase::Stopping if !self.moving => Some(self.turn(t, turn)),
             Phase::Turning { id, sent_ns } if lost(id, sent_ns) => Some(self.turn(t, turn)),
             Phase::Dashing { id, sent_ns } if lost(id, sent_ns) => {
-                Some(self.dash(t, (self.ahead_m - self.p.stop_m - DASH_MARGIN_M).min(self.p.dash_m).max(0.0)))
+                Some(self.dash(t, self.dash_room().max(0.0)))
             }
             Phase::Turning { id, .. } | Phase::Dashing { id, .. } if finished(id) => {
                 let first = matches!(self.phase, Phase::Turning { .. });
                 // A dash, and more while the object still approaches, cut short of anything
                 // ahead (the panic-stop would freeze the robot there anyway).
-                let room = (self.ahead_m - self.p.stop_m - DASH_MARGIN_M).min(self.p.dash_m);
+                let room = self.dash_room();
                 if (first || self.approaching) && room >= MIN_DASH_M {
                     return Some(self.dash(t, room));
                 }
@@ -176,6 +176,11 @@ impl PanicAvoid {
         let c = self.command(CommandKind::Turn, t, 0.0, angle_rad);
         self.phase = Phase::Turning { id: c.command_id, sent_ns: t };
         c
+    }
+
+    /// How far a dash may go: its length, cut short of what is ahead.
+    fn dash_room(&self) -> f64 {
+        (self.ahead_m - self.p.stop_m - DASH_MARGIN_M).min(self.p.dash_m)
     }
 
     fn hold(&mut self, t: u64) -> MotionCommand {
