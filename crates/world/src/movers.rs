@@ -114,10 +114,6 @@ impl World {
             }
         }
     }
-
-    pub fn movers(&self) -> &[Mover] {
-        &self.movers
-    }
 }
 
 #[cfg(test)]

@@ -24,7 +24,7 @@ pub(super) struct Columns {
 
 /// The margin (pixels) of a `k x k` window where the interest is not defined (it is 0 there):
 /// the shifted window must stay inside.
-pub(super) fn margin(k: usize) -> usize {
+fn margin(k: usize) -> usize {
     k / 2 + 1
 }
 
