@@ -17,6 +17,22 @@ pub struct Pose {
     pub heading_deg: f64,
 }
 
+impl std::str::FromStr for Pose {
+    type Err = String;
+
+    /// `x_m,y_m,heading_deg`, as a command line gives a start pose (`--start 5,4,-90`).
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let v: Vec<f64> = s
+            .split(',')
+            .map(|p| p.trim().parse::<f64>().map_err(|e| format!("pose `{s}`: `{p}`: {e}")))
+            .collect::<Result<_, _>>()?;
+        match v[..] {
+            [x_m, y_m, heading_deg] if v.iter().all(|c| c.is_finite()) => Ok(Pose { x_m, y_m, heading_deg }),
+            _ => Err(format!("pose `{s}`: want three finite numbers `x_m,y_m,heading_deg`")),
+        }
+    }
+}
+
 /// A rectangle on a wall with its own reflectance (a door, a sign, a baseboard).
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -209,5 +225,20 @@ impl World {
 
     pub fn landmark(&self, name: &str) -> Option<&Landmark> {
         self.landmarks.iter().find(|l| l.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Pose;
+
+    #[test]
+    fn a_start_pose_is_read_from_the_command_line_form() {
+        let p: Pose = "5, 4.5,-90".parse().expect("parses");
+        assert_eq!(p, Pose { x_m: 5.0, y_m: 4.5, heading_deg: -90.0 });
+        let e = "5,4".parse::<Pose>().expect_err("two numbers");
+        assert!(e.contains("`5,4`") && e.contains("three finite numbers"), "{e}");
+        assert!("5,x,0".parse::<Pose>().expect_err("not a number").contains("`x`"));
+        assert!("5,4,inf".parse::<Pose>().is_err());
     }
 }

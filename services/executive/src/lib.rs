@@ -6,6 +6,7 @@
 pub mod fsa;
 pub mod leg;
 pub mod mission;
+pub mod monitor;
 pub mod plan;
 pub mod pose;
 pub mod recover;
@@ -83,7 +84,12 @@ pub struct Executive {
     /// Plan-level servoing: what it needs, what the current look found, the latest odometry,
     /// and the belief `(odometry then, refined pose then)` since the last refinement.
     refine: Option<refining::RefineSetup>,
+    asked: Vec<usize>,
     looks: Vec<Option<[f64; 2]>>,
+    /// Pose fixes made so far.
+    pub fixes: u32,
+    /// Plan-and-monitor, when the mission is a `ptrans` goal: it appends the steps.
+    pub plan: Option<monitor::Monitor>,
     odometry: Pose2,
     belief: Option<(Pose2, Pose2)>,
     /// Times a reflex interrupted the mission.
@@ -120,6 +126,12 @@ impl Executive {
         self
     }
 
+    /// With plan-and-monitor developing the mission's `ptrans` goal.
+    pub fn with_plan(mut self, monitor: monitor::Monitor) -> Self {
+        self.plan = Some(monitor);
+        self
+    }
+
     pub fn new(mission: Mission, servo: Vec<Option<ServoSetup>>) -> Self {
         Self {
             mission,
@@ -131,7 +143,10 @@ impl Executive {
             recovery: Vec::new(),
             servo_seq: 0,
             refine: None,
+            asked: Vec::new(),
             looks: Vec::new(),
+            fixes: 0,
+            plan: None,
             odometry: Pose2::default(),
             belief: None,
             preemptions: 0,
@@ -233,13 +248,36 @@ impl Executive {
         }
     }
 
-    /// Step `step` is over: the next one, or success.
+    /// Step `step` is over: the next one, what the plan wants next, or success.
     fn step_done(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
         if step + 1 < self.mission.steps.len() {
             self.begin(step + 1, at, now)
+        } else if self.plan.is_some() {
+            self.plan_next(at, now)
         } else {
             self.phase = Phase::Done(MissionState::Succeeded);
             Vec::new()
+        }
+    }
+
+    /// Plan-and-monitor's next steps, appended to the script and begun.
+    fn plan_next(&mut self, at: Pose2, now: u64) -> Vec<Output> {
+        let Some(plan) = self.plan.as_mut() else { return Vec::new() };
+        match plan.next(at, self.fixes) {
+            Ok(monitor::Next::Steps(steps)) => {
+                let first = self.mission.steps.len();
+                self.mission.steps.extend(steps);
+                self.begin(first, at, now)
+            }
+            Ok(monitor::Next::Arrived) => {
+                self.phase = Phase::Done(MissionState::Succeeded);
+                Vec::new()
+            }
+            Err(e) => {
+                tracing::error!(error = %e, "plan-and-monitor failed");
+                self.phase = Phase::Done(MissionState::Failed);
+                Vec::new()
+            }
         }
     }
 
@@ -295,8 +333,16 @@ impl Executive {
         match self.phase {
             Phase::Waiting => {
                 self.start_ns = now;
-                self.goal = goal_of(at, &self.mission.steps);
-                out = self.begin(0, at, now);
+                match &self.plan {
+                    Some(plan) => {
+                        self.goal = plan.goal_pose();
+                        out = self.plan_next(at, now);
+                    }
+                    None => {
+                        self.goal = goal_of(at, &self.mission.steps);
+                        out = self.begin(0, at, now);
+                    }
+                }
             }
             Phase::Executing { step, .. } | Phase::Looking { step, .. }
                 if recover::is_reflex(o.command.command_id)
@@ -402,6 +448,7 @@ mod tests {
             timeout_s,
             servo: None,
             refine: None,
+            ptrans: None,
             steps: vec![
                 Step { move_m: Some(2.0), ..Step::default() },
                 Step { turn_deg: Some(90.0), ..Step::default() },

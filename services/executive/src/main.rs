@@ -9,6 +9,7 @@ use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_executive::leg::ServoSetup;
 use harvey_executive::mission::Mission;
+use harvey_executive::monitor::Monitor;
 use harvey_executive::pose::{PinholeCamera, RefineParams};
 use harvey_executive::refining::RefineSetup;
 use harvey_executive::servo::ServoParams;
@@ -96,6 +97,7 @@ fn refine_setup(m: &Mission, world: Option<&World>) -> anyhow::Result<Option<Ref
         },
         template_px: r.template_px,
         min_score: r.min_score,
+        world: Some(w.clone()),
     }))
 }
 
@@ -108,6 +110,19 @@ fn main() -> anyhow::Result<()> {
     let world = args.world.as_deref().map(World::load).transpose()?;
     let servo = servo_setups(&mission, world.as_ref())?;
     let refine = refine_setup(&mission, world.as_ref())?;
+    let exec_goal = match &mission.ptrans {
+        Some(goal) => {
+            let w = world.clone().context("[mission.ptrans] needs --world")?;
+            anyhow::ensure!(
+                w.locales.iter().any(|l| l.name == goal.to),
+                "[mission.ptrans] goes to locale {}, which world {} lacks",
+                goal.to,
+                w.name
+            );
+            Some(Monitor::new(goal.clone(), w))
+        }
+        None => None,
+    };
     tracing::info!(description = %mission.description, steps = mission.steps.len(), "mission loaded");
 
     let bus = Bus::join("executive")?;
@@ -129,6 +144,9 @@ fn main() -> anyhow::Result<()> {
     let mut exec = Executive::new(mission, servo);
     if let Some(setup) = refine {
         exec = exec.with_refine(setup);
+    }
+    if let Some(goal) = exec_goal {
+        exec = exec.with_plan(goal);
     }
     let (mut odos, mut seen) = (Vec::new(), Vec::new());
     let mut out = Vec::new();

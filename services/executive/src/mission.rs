@@ -1,6 +1,6 @@
 //! The mission a launch file gives the executive: a script of TURN and MOVE primitives with a
-//! time limit; a move may be driven in increments and servoed on a landmark (000 §5.5).
-//! Plan-and-monitor over the locale graph replaces the script in its own issue.
+//! time limit, a move perhaps driven in increments and servoed on a landmark (000 §5.5); or a
+//! goal `(ptrans a b)` that plan-and-monitor develops over the world's locale graph (000 §2).
 
 use serde::Deserialize;
 
@@ -59,6 +59,32 @@ pub struct Servo {
     pub offset: crate::leg::Tracking,
 }
 
+/// A goal for plan-and-monitor (`[mission.ptrans]`, 000 §2, §4): get to a place in locale `to`
+/// from wherever the robot starts, checking a milestone after each subgoal.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PtransGoal {
+    /// The goal locale (a locale of the world), and the place in it (m) with the heading to take.
+    pub to: String,
+    pub goal_m: [f64; 2],
+    pub goal_heading_deg: f64,
+    /// The last subgoal comes in along the goal heading from this far back, so the robot arrives
+    /// facing the right way and never turns far on the spot at the goal (turns skitter, 002 §3.2).
+    pub approach_m: f64,
+    /// How far either side of a doorway its milestones are.
+    pub door_depth_m: f64,
+    /// A milestone is reached when the robot is believed this close to it; the goal, `goal_m`.
+    pub milestone_m: f64,
+    pub goal_tolerance_m: f64,
+    /// A milestone missed by less than this is retried from where the robot is (plan level);
+    /// by more, or `attempts` times, the plan is developed afresh from there (goal level).
+    pub escalate_m: f64,
+    pub attempts: u32,
+    /// A target closer than this is moved to straight, if nearly dead ahead or behind, or else
+    /// approached by backing off first.
+    pub back_off_m: f64,
+}
+
 /// The `[mission]` table of a launch file.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -66,10 +92,11 @@ pub struct Mission {
     pub description: String,
     /// Simulated seconds before the mission counts as failed.
     pub timeout_s: f64,
-    #[serde(rename = "step")]
+    #[serde(default, rename = "step")]
     pub steps: Vec<Step>,
     pub servo: Option<Servo>,
     pub refine: Option<Refine>,
+    pub ptrans: Option<PtransGoal>,
 }
 
 #[derive(Deserialize)]
@@ -87,8 +114,15 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
     if !greater(m.timeout_s, 0.0) {
         return Err(format!("{file}: mission.timeout_s must be positive"));
     }
-    if m.steps.is_empty() {
-        return Err(format!("{file}: the mission has no [[mission.step]]"));
+    match &m.ptrans {
+        None if m.steps.is_empty() => {
+            return Err(format!("{file}: the mission has no [[mission.step]] and no [mission.ptrans]"));
+        }
+        Some(_) if !m.steps.is_empty() => {
+            return Err(format!("{file}: [mission.ptrans] plans its own steps: drop [[mission.step]]"));
+        }
+        Some(p) => check_ptrans(p).map_err(|e| format!("{file}: mission.ptrans: {e}"))?,
+        None => {}
     }
     for (i, s) in m.steps.iter().enumerate() {
         match (s.move_m, s.turn_deg, s.refine_pose) {
@@ -118,6 +152,21 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
         return Err(format!("{file}: mission.servo: aim_m must be positive, template_px at least 4"));
     }
     Ok(m)
+}
+
+fn check_ptrans(p: &PtransGoal) -> Result<(), String> {
+    let lengths =
+        [p.approach_m, p.door_depth_m, p.milestone_m, p.goal_tolerance_m, p.escalate_m, p.back_off_m];
+    if !lengths.iter().all(|&v| greater(v, 0.0)) || !p.goal_heading_deg.is_finite() {
+        return Err("lengths must be positive and the heading finite".into());
+    }
+    if !p.goal_m.iter().all(|v| v.is_finite()) || p.attempts == 0 {
+        return Err("goal_m must be finite and attempts at least 1".into());
+    }
+    if p.escalate_m <= p.milestone_m.max(p.goal_tolerance_m) {
+        return Err("escalate_m must exceed milestone_m and goal_tolerance_m".into());
+    }
+    Ok(())
 }
 
 /// `v > min`, false for NaN: the check that a number is usable.
@@ -151,6 +200,12 @@ mod tests {
         let table = format!("{servoed}[mission.servo]\naim_m = 1.2\ntemplate_px = 16\nmin_score = 0.9\n");
         let m = parse(&table, "m.toml").expect("parses");
         assert_eq!((m.steps[0].increment_m, m.servo.map(|s| s.aim_m)), (Some(0.5), Some(1.2)));
+        let ptrans = "[mission]\ndescription = \"d\"\ntimeout_s = 60\n[mission.ptrans]\nto = \"office\"\ngoal_m = [1.0, 2.0]\ngoal_heading_deg = 90\napproach_m = 0.4\ndoor_depth_m = 0.6\nmilestone_m = 0.15\ngoal_tolerance_m = 0.01\nescalate_m = 0.5\nattempts = 3\nback_off_m = 0.3\n";
+        assert_eq!(parse(ptrans, "p.toml").expect("parses").ptrans.map(|p| p.goal_m), Some([1.0, 2.0]));
+        let both = format!("{ptrans}[[mission.step]]\nmove_m = 1.0\n");
+        assert!(parse(&both, "p.toml").expect_err("steps too").contains("drop [[mission.step]]"));
+        let tight = ptrans.replace("escalate_m = 0.5", "escalate_m = 0.1");
+        assert!(parse(&tight, "p.toml").expect_err("escalate").contains("mission.ptrans: escalate_m"));
         let on_turn = text.replace("turn_deg = 90", "turn_deg = 90\nincrement_m = 0.5");
         assert!(parse(&on_turn, "m.toml").expect_err("turn").contains("step[1].increment_m"));
     }

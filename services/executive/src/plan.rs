@@ -30,6 +30,8 @@ pub enum PlanError {
     UnknownLocale(String),
     #[error("no route of doorways from {0} to {1}")]
     NoRoute(String, String),
+    #[error("gave up at milestone {0}, last known at {1:.2?} m")]
+    GaveUp(String, [f64; 2]),
 }
 
 /// The doorways (indices into `world.doors`) leading from locale `from` to `to`, found

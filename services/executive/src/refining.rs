@@ -21,6 +21,45 @@ pub struct RefineSetup {
     pub params: RefineParams,
     pub template_px: u32,
     pub min_score: f64,
+    /// The world, to ask only for vertices in view and not hidden behind a wall; without it,
+    /// every vertex is asked for.
+    pub world: Option<harvey_world::World>,
+}
+
+/// At most this many vertices are asked for at once (the vision request queue holds 16).
+pub const MAX_ASKED: usize = 16;
+/// Fewer vertices in view than this, and no fix is tried.
+pub const MIN_ASKED: usize = 3;
+
+impl RefineSetup {
+    /// The vertices (indices) worth asking for from `pose`: in the image clear of its edges by a
+    /// template, 0.5 to 20 m ahead, with no wall between; the nearest `MAX_ASKED`, in list order.
+    pub fn in_view(&self, pose: Pose2, image_px: [f64; 2]) -> Vec<usize> {
+        let margin = f64::from(self.template_px);
+        let mut seen: Vec<(usize, f64)> = self
+            .vertices
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &(_, _, v))| {
+                let [u, w] = self.camera.project(pose, v)?;
+                let inside = (margin..image_px[0] - margin).contains(&u)
+                    && (margin..image_px[1] - margin).contains(&w);
+                let (dx, dy) = (v[0] - pose.x_m, v[1] - pose.y_m);
+                let d = dx.hypot(dy);
+                let clear = self.world.as_ref().is_none_or(|world| {
+                    world
+                        .cast_ray([pose.x_m, pose.y_m], [dx / d, dy / d], d)
+                        .is_none_or(|h| h.distance_m > d - 0.05)
+                });
+                (inside && clear && (0.5..20.0).contains(&d)).then_some((i, d))
+            })
+            .collect();
+        seen.sort_by(|a, b| a.1.total_cmp(&b.1));
+        seen.truncate(MAX_ASKED);
+        let mut ids: Vec<usize> = seen.into_iter().map(|(i, _)| i).collect();
+        ids.sort_unstable();
+        ids
+    }
 }
 
 /// `rel` (a pose in `base`'s frame) in the world.
@@ -60,17 +99,23 @@ impl Executive {
             self.belief = Some((self.odometry, Pose2 { x_m: b.x_m + dx, y_m: b.y_m + dy, ..b }));
             self.estimated = self.believed();
         }
+        let expected = self.estimated;
+        let c = setup.camera.centre_px;
+        self.asked = setup.in_view(expected, [2.0 * c[0], 2.0 * c[1]]);
+        if self.asked.len() < MIN_ASKED {
+            tracing::info!(in_view = self.asked.len(), "too few landmark vertices in view for a pose fix");
+            return self.step_done(step, expected, now);
+        }
         let first = self.next_request;
-        let n = setup.vertices.len() as u32;
+        let n = self.asked.len() as u32;
         self.next_request += n;
         self.looks = vec![None; n as usize];
         self.phase = Phase::Refining { step, first, received: 0, since_ns: now };
-        let expected = self.estimated;
-        setup
-            .vertices
+        self.asked
             .iter()
+            .map(|&i| setup.vertices[i])
             .enumerate()
-            .map(|(k, &(landmark_index, offset, _))| {
+            .map(|(k, (landmark_index, offset, _))| {
                 let id = first + k as u32;
                 Output::Look(VisionRequest::correlate(
                     id,
@@ -107,15 +152,22 @@ impl Executive {
     /// Refines the pose from the vertices found (all answered, or the wait is over).
     pub(crate) fn finish_refine(&mut self, step: usize, now: u64) -> Vec<Output> {
         let Some(setup) = &self.refine else { return Vec::new() };
-        let matches: Vec<VertexMatch> = setup
-            .vertices
+        let matches: Vec<VertexMatch> = self
+            .asked
             .iter()
+            .map(|&i| setup.vertices[i].2)
             .zip(&self.looks)
-            .filter_map(|(&(_, _, world_m), seen)| seen.map(|image_px| VertexMatch { world_m, image_px }))
+            .filter_map(|(world_m, seen)| seen.map(|image_px| VertexMatch { world_m, image_px }))
             .collect();
         let expected = self.estimated;
         let mut out = Vec::new();
         match refine(&setup.camera, expected, &matches, &setup.params) {
+            // Too few matches agreeing: no fix (a pose from two vertices fits anything).
+            Some(done) if done.kept.len() < MIN_ASKED => tracing::warn!(
+                found = matches.len(),
+                kept = done.kept.len(),
+                "too few vertices agree to fix the pose"
+            ),
             Some(done) => {
                 tracing::info!(
                     expected_x = expected.x_m,
@@ -130,12 +182,13 @@ impl Executive {
                 );
                 self.belief = Some((self.odometry, done.pose));
                 self.estimated = done.pose;
+                self.fixes += 1;
                 self.servo_seq += 1;
                 out.push(Output::Pose(PoseFix {
                     header: Header::new(self.servo_seq, now),
                     expected,
                     refined: done.pose,
-                    asked: setup.vertices.len() as u32,
+                    asked: self.asked.len() as u32,
                     found: matches.len() as u32,
                     kept: done.kept.len() as u32,
                     reserved: 0,

@@ -31,6 +31,10 @@ struct Args {
     /// Seed of the error model.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Where the robot starts, `x_m,y_m,heading_deg`, instead of the world's `[start]` (a
+    /// mission's own start).
+    #[arg(long)]
+    start: Option<harvey_world::Pose>,
     /// A launch file whose `[[mover]]` tables put moving things in the world.
     #[arg(long)]
     movers: Option<PathBuf>,
@@ -41,6 +45,9 @@ fn main() -> anyhow::Result<()> {
     let args = Args::parse();
     anyhow::ensure!(args.tick_ms > 0 && args.speedup > 0.0, "--tick-ms and --speedup must be positive");
     let mut world = harvey_world::World::load(&args.world)?;
+    if let Some(start) = args.start {
+        world.start = start;
+    }
     if let Some(file) = &args.movers {
         world.add_movers(harvey_world::load_movers(file)?);
     }

@@ -2,10 +2,13 @@
 //! readings, with the robot's own motion taken out, show whether something is coming at it.
 //!
 //! A reading `r` along the sensor's axis `u` from the robot at `p` puts the echo at `p + r u`;
-//! for a still object `r + p·u` stays constant while the robot drives, so its slope over the
-//! sensor's last few readings (a least-squares fit) is the object's own speed towards the robot.
+//! for a still object `r + (p - q)·u` stays constant while the robot drives (`q` any fixed point:
+//! the newest reading's pose, so that small turns far from the world's origin do not swing it),
+//! so its slope over the sensor's last few readings (a least-squares fit) is the object's own
+//! speed towards the robot.
 //! The robot's pose at each reading's stamp comes from odometry (interpolated); while the robot
-//! turns, the axis sweeps over other things, so a window spanning a turn starts afresh.
+//! turns, the axis sweeps over other things, so a window spanning a turn starts afresh, as does
+//! one whose range jumps (another surface).
 
 use std::collections::VecDeque;
 
@@ -17,6 +20,10 @@ use crate::bearing_rad;
 const WINDOW: usize = 4;
 /// Odometry poses kept for interpolation.
 const POSES: usize = 16;
+/// A compensated range that jumps by more than this from the sensor's last is another surface
+/// (the beam slid off an edge, or a specular wall fell silent): the window starts afresh. A
+/// reading comes every 0.15 s, so only something closing at over 2 m/s moves this far between.
+const MAX_STEP_M: f64 = 0.3;
 
 /// Settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,13 +36,27 @@ pub struct ApproachParams {
     pub max_turn_rad: f64,
 }
 
+/// One reading: its time (s), range (m), the robot's position (m) and the sensor's axis.
+#[derive(Debug, Clone, Copy, Default)]
+struct Reading {
+    t: f64,
+    r: f64,
+    p: [f64; 2],
+    u: [f64; 2],
+    heading: f64,
+}
+
+impl Reading {
+    /// The range compensated for the robot's motion since `q`: `r + (p - q)·u`.
+    fn compensated(&self, q: [f64; 2]) -> f64 {
+        self.r + (self.p[0] - q[0]) * self.u[0] + (self.p[1] - q[1]) * self.u[1]
+    }
+}
+
 #[derive(Debug, Clone, Copy, Default)]
 struct Window {
     n: usize,
-    /// Reading time (s), compensated range `r + p·u` (m), robot heading (rad).
-    t: [f64; WINDOW],
-    c: [f64; WINDOW],
-    heading: [f64; WINDOW],
+    readings: [Reading; WINDOW],
     last_stamp: u64,
     /// Consecutive readings that showed an approach within the time to contact.
     streak: u32,
@@ -44,28 +65,32 @@ struct Window {
 }
 
 impl Window {
-    fn push(&mut self, t: f64, c: f64, heading: f64) {
+    fn push(&mut self, reading: Reading) {
         if self.n == WINDOW {
-            self.t.copy_within(1.., 0);
-            self.c.copy_within(1.., 0);
-            self.heading.copy_within(1.., 0);
+            self.readings.copy_within(1.., 0);
             self.n -= 1;
         }
-        (self.t[self.n], self.c[self.n], self.heading[self.n]) = (t, c, heading);
+        self.readings[self.n] = reading;
         self.n += 1;
+    }
+
+    fn last(&self) -> Option<&Reading> {
+        self.n.checked_sub(1).map(|k| &self.readings[k])
     }
 
     /// The least-squares slope of the compensated range (m/s), once the window is full.
     fn slope(&self) -> Option<f64> {
+        let q = self.last()?.p;
         if self.n < WINDOW {
             return None;
         }
-        let (mt, mc) =
-            (self.t.iter().sum::<f64>() / WINDOW as f64, self.c.iter().sum::<f64>() / WINDOW as f64);
+        let c = self.readings.map(|x| x.compensated(q));
+        let mt = self.readings.iter().map(|x| x.t).sum::<f64>() / WINDOW as f64;
+        let mc = c.iter().sum::<f64>() / WINDOW as f64;
         let (mut stc, mut stt) = (0.0, 0.0);
-        for k in 0..WINDOW {
-            stc += (self.t[k] - mt) * (self.c[k] - mc);
-            stt += (self.t[k] - mt) * (self.t[k] - mt);
+        for (x, c) in self.readings.iter().zip(c) {
+            stc += (x.t - mt) * (c - mc);
+            stt += (x.t - mt) * (x.t - mt);
         }
         (stt > 0.0).then(|| stc / stt)
     }
@@ -140,12 +165,21 @@ impl Approach {
                 continue; // no new reading of this sensor
             }
             w.last_stamp = stamp;
-            if w.n > 0 && (th - w.heading[0]).abs() > self.p.max_turn_rad {
+            let dir = th + bearing_rad(i);
+            let reading = Reading {
+                t: stamp as f64 * 1e-9,
+                r: f64::from(r),
+                p: [x, y],
+                u: [dir.cos(), dir.sin()],
+                heading: th,
+            };
+            let jumped = w.last().is_some_and(|l| (reading.compensated(l.p) - l.r).abs() > MAX_STEP_M);
+            let turned = w.n > 0 && (th - w.readings[0].heading).abs() > self.p.max_turn_rad;
+            if turned || jumped {
                 *w = Window { last_stamp: stamp, ..Window::default() };
             }
-            let dir = th + bearing_rad(i);
-            let u = [dir.cos(), dir.sin()];
-            w.push(stamp as f64 * 1e-9, f64::from(r) + x * u[0] + y * u[1], th);
+            let u = reading.u;
+            w.push(reading);
             let approach = w.slope().map_or(0.0, |s| -s);
             let closing = approach + v[0] * u[0] + v[1] * u[1];
             w.closing = approach >= self.p.min_approach_mps && closing > 0.0;

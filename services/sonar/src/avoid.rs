@@ -306,6 +306,35 @@ mod tests {
     }
 
     #[test]
+    fn a_range_that_jumps_to_another_surface_is_no_approach() {
+        let mut a = PanicAvoid::new(P);
+        // Backing away from a room's corner: the forward beam slides off one wall onto the
+        // other, and its range drops by a metre between two readings, then keeps growing.
+        for k in 0..20 {
+            let t = 0.15 * k as f64;
+            a.on_odometry(&odo(t, -0.3 * t, true, 1));
+            let ahead = if k < 8 { 3.0 + 0.3 * t } else { 2.0 + 0.3 * t };
+            assert_eq!(a.on_ring(&ring(t, ahead as f32, 2.0, 2.0)), None, "at {t} s");
+        }
+        assert_eq!(a.episodes, 0);
+    }
+
+    #[test]
+    fn a_small_turn_far_from_the_origin_is_no_approach() {
+        let mut a = PanicAvoid::new(P);
+        // 12 m from the world's origin and facing across that line, standing, then turning 1
+        // degree (under the turn that restarts a window): every range stays the same.
+        for k in 0..20 {
+            let t = 0.15 * k as f64;
+            let mut o = odo(t, 12.0, k == 6, 1);
+            o.world_from_robot.heading_rad = if k < 6 { 90f64 } else { 91f64 }.to_radians();
+            a.on_odometry(&o);
+            assert_eq!(a.on_ring(&ring(t, 1.2, 2.0, 2.0)), None, "at {t} s");
+        }
+        assert_eq!(a.episodes, 0);
+    }
+
+    #[test]
     fn an_object_bearing_down_makes_the_robot_stop_turn_to_the_clear_side_and_dash() {
         let mut a = PanicAvoid::new(P);
         // The robot stands still; something comes at it at 0.6 m/s from 5 m; more room on the right.

@@ -23,6 +23,10 @@ struct Args {
     /// Predicted landmarks missed in a row before the robot counts as lost.
     #[arg(long, default_value_t = 3)]
     lost_after_misses: u32,
+    /// Where the robot starts, `x_m,y_m,heading_deg`, instead of the world's `[start]` (a
+    /// mission's own start).
+    #[arg(long)]
+    start: Option<harvey_world::Pose>,
     /// How late a sighting may arrive and still be applied at its own stamp.
     #[arg(long, default_value_t = 2000)]
     history_ms: u64,
@@ -35,7 +39,10 @@ fn main() -> anyhow::Result<()> {
         args.sigmas > 0.0 && args.lost_area_m2 > 0.0,
         "--sigmas and --lost-area-m2 must be positive"
     );
-    let world = harvey_world::World::load(&args.world)?;
+    let mut world = harvey_world::World::load(&args.world)?;
+    if let Some(start) = args.start {
+        world.start = start;
+    }
     let image_px = (world.camera.width_px, world.camera.height_px);
     let config = Config {
         sigmas: args.sigmas,

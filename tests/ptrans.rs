@@ -1,0 +1,76 @@
+//! 000 §2 and §4 as a mission: `(ptrans robot-lab teds-office)`. Plan-and-monitor develops the
+//! goal over the hallway world's locale graph (through the lab's door, down the hall, through
+//! the office's door), checks a milestone after each subgoal, fixes the pose from landmark
+//! vertices on the way (000 §5.6), and ends within an inch of Ted's desk.
+
+mod common;
+
+use harvey_msgs::{Pose2, PoseFix, TruePose};
+
+const INCH: f64 = 0.0254;
+
+/// The true pose at (or just before) `stamp_ns`.
+fn truth_at(truth: &[(u64, Pose2)], stamp_ns: u64) -> Pose2 {
+    let k = truth.partition_point(|t| t.0 <= stamp_ns);
+    truth[k.saturating_sub(1)].1
+}
+
+#[test]
+fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
+    let out = common::run_mission("missions/ptrans.toml", "ptrans");
+    let (mut fixes, mut truth) = (Vec::new(), Vec::new());
+    for m in mcap::MessageStream::new(&out.mcap).expect("mcap") {
+        let m = m.expect("message");
+        match m.channel.topic.as_str() {
+            "/executive/pose" => fixes.push(harvey_cdr::decode::<PoseFix>(&m.data).expect("fix")),
+            "/sim/truth" => {
+                let t = harvey_cdr::decode::<TruePose>(&m.data).expect("truth");
+                truth.push((t.header.stamp_ns, t.world_from_robot));
+            }
+            _ => {}
+        }
+    }
+    for f in &fixes {
+        let t = truth_at(&truth, f.header.stamp_ns);
+        println!(
+            "fix at t={:.2}s: truth ({:.3}, {:.3}, {:.2} deg) expected {:.2} in off, refined {:.2} in off, heading {:+.2} deg ({} of {} kept, {:.2} px)",
+            f.header.stamp_ns as f64 / 1e9,
+            t.x_m,
+            t.y_m,
+            t.heading_rad.to_degrees(),
+            (f.expected.x_m - t.x_m).hypot(f.expected.y_m - t.y_m) / INCH,
+            (f.refined.x_m - t.x_m).hypot(f.refined.y_m - t.y_m) / INCH,
+            (f.refined.heading_rad - t.heading_rad).to_degrees(),
+            f.kept,
+            f.asked,
+            f.rms_px
+        );
+    }
+    assert!(out.status.success() && out.stdout.contains("goal reached"), "{}\n{}", out.stdout, out.stderr);
+    // The true path crossed the north wall's line (y = 1) in the lab's doorway, going out, and
+    // in the office's, going in, and nowhere else.
+    let crossings: Vec<(f64, bool)> = truth
+        .windows(2)
+        .filter(|w| (w[0].1.y_m - 1.0).signum() != (w[1].1.y_m - 1.0).signum())
+        .map(|w| (w[1].1.x_m, w[1].1.y_m > 1.0))
+        .collect();
+    println!("crossed y = 1 at {crossings:?}");
+    assert!(!crossings.is_empty());
+    let (out_of_lab, into_office) = crossings.split_at(crossings.len() / 2);
+    assert!(out_of_lab.iter().all(|&(x, _)| (4.0..4.9).contains(&x)), "{crossings:?}");
+    assert!(into_office.iter().all(|&(x, _)| (11.0..11.9).contains(&x)), "{crossings:?}");
+    assert_eq!(crossings.first().map(|c| c.1), Some(false));
+    assert_eq!(crossings.last().map(|c| c.1), Some(true));
+    // Every pose fix put the robot within 6 in of the truth (the weakest: six vertices on the
+    // end wall 4.5 m off, all at one depth).
+    assert!(fixes.len() >= 5, "{} fixes", fixes.len());
+    for f in &fixes {
+        let t = truth_at(&truth, f.header.stamp_ns);
+        let off_in = (f.refined.x_m - t.x_m).hypot(f.refined.y_m - t.y_m) / INCH;
+        assert!(off_in < 6.0, "a fix {off_in:.2} in off: {f:?}");
+    }
+    let end = truth.last().expect("truth").1;
+    let off_in = (end.x_m - 12.0).hypot(end.y_m - 2.5) / INCH;
+    println!("ends {off_in:.2} in from the goal, heading {:.2} deg", end.heading_rad.to_degrees());
+    assert!(off_in < 1.0, "ends {off_in:.2} in from the goal");
+}
