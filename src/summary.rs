@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use anyhow::Context;
-use harvey_msgs::{MissionState, MissionStatus, TruePose, UncertaintyMap};
+use harvey_msgs::{CheckOutcome, MissionState, MissionStatus, PlanSketch, TruePose, UncertaintyMap};
 
 /// One line of the summary: a labelled pose.
 fn pose_line(label: &str, p: &harvey_msgs::Pose2) -> String {
@@ -34,6 +34,10 @@ pub struct RunStats {
     pub last_status: Option<MissionStatus>,
     pub last_truth: Option<TruePose>,
     pub last_map: Option<UncertaintyMap>,
+    pub last_plan: Option<PlanSketch>,
+    /// Milestone checks by outcome (reached, retried, replanned), and pose fixes.
+    pub checks: [u32; 3],
+    pub fixes: u32,
 }
 
 impl RunStats {
@@ -57,6 +61,20 @@ impl RunStats {
                 "executive/status" => run.last_status = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
                 "sim/truth" => run.last_truth = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
                 "ums/map" => run.last_map = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
+                "executive/pose" => run.fixes += 1,
+                "executive/plan" => {
+                    let p: PlanSketch = harvey_cdr::decode(&m.data).map_err(bad)?;
+                    let checks_before = run.last_plan.map_or(0, |q| q.checks);
+                    if p.checks > checks_before {
+                        let k = match p.last_outcome {
+                            o if o == CheckOutcome::Reached as u32 => 0,
+                            o if o == CheckOutcome::Retried as u32 => 1,
+                            _ => 2,
+                        };
+                        run.checks[k] += 1;
+                    }
+                    run.last_plan = Some(p);
+                }
                 _ => {}
             }
         }
@@ -135,6 +153,14 @@ impl RunStats {
                 m.vertex_count,
                 wedge,
                 if m.lost == 1 { ", LOST" } else { "" }
+            );
+        }
+        if self.last_plan.is_some() {
+            let [reached, retried, replanned] = self.checks;
+            out += &format!(
+                "  plan-and-monitor: {} milestone checks ({reached} reached, {retried} retried, {replanned} replanned), {} pose fixes\n",
+                reached + retried + replanned,
+                self.fixes
             );
         }
         out += &format!(

@@ -5,7 +5,7 @@
 
 mod common;
 
-use harvey_msgs::{Pose2, PoseFix, TruePose};
+use harvey_msgs::{CheckOutcome, PlanSketch, PlanStage, Pose2, PoseFix, TruePose};
 
 const INCH: f64 = 0.0254;
 
@@ -18,11 +18,12 @@ fn truth_at(truth: &[(u64, Pose2)], stamp_ns: u64) -> Pose2 {
 #[test]
 fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
     let out = common::run_mission("missions/ptrans.toml", "ptrans");
-    let (mut fixes, mut truth) = (Vec::new(), Vec::new());
+    let (mut fixes, mut truth, mut plans) = (Vec::new(), Vec::new(), Vec::new());
     for m in mcap::MessageStream::new(&out.mcap).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
             "/executive/pose" => fixes.push(harvey_cdr::decode::<PoseFix>(&m.data).expect("fix")),
+            "/executive/plan" => plans.push(harvey_cdr::decode::<PlanSketch>(&m.data).expect("plan")),
             "/sim/truth" => {
                 let t = harvey_cdr::decode::<TruePose>(&m.data).expect("truth");
                 truth.push((t.header.stamp_ns, t.world_from_robot));
@@ -69,6 +70,16 @@ fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
         let off_in = (f.refined.x_m - t.x_m).hypot(f.refined.y_m - t.y_m) / INCH;
         assert!(off_in < 6.0, "a fix {off_in:.2} in off: {f:?}");
     }
+    // The published sketch: first from the bench, detailed at the front (to the lab's door and
+    // through it) and abstract at the back (the hall to the office); last, arrived.
+    let first = plans.first().expect("a plan sketch");
+    // (Odometry's start, in hundredths of a foot.)
+    assert!((first.places_m[0] - 5.0).abs() < 0.01 && (first.places_m[1] - 4.0).abs() < 0.01, "{first:?}");
+    assert_eq!((first.place_count, first.primitive_mask), (5, 0b1011), "{first:?}");
+    assert_eq!((first.places_m[2], first.places_m[3]), (4.45, 2.0));
+    let last = plans.last().expect("a plan sketch");
+    assert_eq!((last.stage, last.last_outcome), (PlanStage::Arrived as u32, CheckOutcome::Reached as u32));
+    assert!(last.checks >= 6 && last.last_off_m <= 0.0127, "{last:?}");
     let end = truth.last().expect("truth").1;
     let off_in = (end.x_m - 12.0).hypot(end.y_m - 2.5) / INCH;
     println!("ends {off_in:.2} in from the goal, heading {:.2} deg", end.heading_rad.to_degrees());

@@ -7,7 +7,7 @@ use harvey_msgs::{
     VisionItem, VisionRequest, VisionResult,
 };
 
-use harvey_msgs::PoseFix;
+use harvey_msgs::{PlanSketch, PoseFix};
 
 use crate::codec::{Cdr, CdrError, CdrReader, CdrWriter};
 use crate::schema::Def;
@@ -140,6 +140,7 @@ ros2_struct!(VisionRequest, VISION_REQUEST = ("harvey_msgs/VisionRequest", with_
 ros2_struct!(VisionResult, VISION_RESULT = ("harvey_msgs/VisionResult", with_header!("uint64 frame_seq\nuint32 request_id\nuint32 algorithm\nuint32 status # 0 found, 1 not found, 2 window outside, 3 unknown landmark, 4 unknown algorithm, 5 bad parameter, 6 bad template, 7 bad frame\nuint32 found\nuint32 count\nuint32 reserved\nharvey_msgs/VisionItem[32] items\n"), [&STD_HEADER, &VISION_ITEM]) { header, frame_seq, request_id, algorithm, status, found, count, reserved, items });
 ros2_struct!(MissionStatus, MISSION_STATUS = ("harvey_msgs/MissionStatus", with_header!("uint32 state # 0 running, 1 succeeded, 2 failed\nuint32 step\nuint32 step_count\nuint32 servo # 0 none, 1 action, 2 plan, 3 goal level\nharvey_msgs/Pose2 estimated\nharvey_msgs/Pose2 goal\nuint64 sonar_rings_seen\nuint64 detections_seen\nuint64 maps_seen\n"), [&STD_HEADER, &POSE2]) { header, state, step, step_count, servo, estimated, goal, sonar_rings_seen, detections_seen, maps_seen });
 ros2_struct!(PoseFix, POSE_FIX = ("harvey_msgs/PoseFix", with_header!("harvey_msgs/Pose2 expected\nharvey_msgs/Pose2 refined\nuint32 asked\nuint32 found\nuint32 kept\nuint32 reserved\nfloat64 rms_px\n"), [&STD_HEADER, &POSE2]) { header, expected, refined, asked, found, kept, reserved, rms_px });
+ros2_struct!(PlanSketch, PLAN_SKETCH = ("harvey_msgs/PlanSketch", with_header!("float64[24] places_m # x0 y0 x1 y1 ...: the subgoal's start, then each milestone\nuint32 place_count\nuint32 primitive_mask # bit k: subgoal k is primitive\nuint32 stage # 0 developing, 1 aiming, 2 moving, 3 arriving, 4 checking, 5 settling, 6 arrived\nuint32 checks\nuint32 replans\nuint32 last_outcome # 0 none, 1 reached, 2 retried, 3 replanned\nfloat64 last_off_m\n"), [&STD_HEADER]) { header, places_m, place_count, primitive_mask, stage, checks, replans, last_outcome, last_off_m });
 ros2_struct!(ServoCorrection, SERVO_CORRECTION = ("harvey_msgs/ServoCorrection", with_header!("uint32 increment\nuint32 landmark_index\nfloat32[2] found_px\nfloat64 heading_error_rad # left positive\nfloat64 correction_rad\nfloat64 offset_m # from the intended line, left positive\nfloat64 shortfall_m\n"), [&STD_HEADER]) { header, increment, landmark_index, found_px, heading_error_rad, correction_rad, offset_m, shortfall_m });
 
 impl Cdr for MotionCommand {

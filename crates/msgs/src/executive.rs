@@ -1,6 +1,6 @@
 //! What the executive publishes about its own working besides its mission status: the servoing
-//! level it is at, each action-level correction (`executive/servo`, 000 §5.5) and each
-//! plan-level pose refinement (`executive/pose`, 000 §5.6).
+//! level it is at, each action-level correction (`executive/servo`, 000 §5.5), each plan-level
+//! pose refinement (`executive/pose`, 000 §5.6) and its plan sketch (`executive/plan`, 000 §2).
 
 use crate::{Header, Message, Pose2, ZeroCopySend};
 
@@ -63,3 +63,57 @@ pub struct PoseFix {
     pub rms_px: f64,
 }
 crate::payloads::message!(PoseFix);
+
+/// Milestones a [`PlanSketch`] carries: more than any route in the worlds has.
+pub const SKETCH_PLACES: usize = 12;
+
+/// Where plan-and-monitor is (000 §2, §4): the plan sketch from the current subgoal's start to
+/// the goal, detailed at the front, abstract at the back, and the latest milestone check.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/PlanSketch")]
+pub struct PlanSketch {
+    pub header: Header,
+    /// `x0 y0 x1 y1 ...`: the current subgoal's start, then the milestone ending each subgoal.
+    pub places_m: [f64; 2 * SKETCH_PLACES],
+    pub place_count: u32,
+    /// Bit `k`: subgoal `k` (from place `k` to `k + 1`) is primitive (a TURN then a MOVE); the
+    /// others are abstract, to be developed when execution reaches them.
+    pub primitive_mask: u32,
+    /// What the current subgoal is doing ([`PlanStage`]).
+    pub stage: u32,
+    /// Milestone checks so far, and plans developed afresh after a miss.
+    pub checks: u32,
+    pub replans: u32,
+    /// The latest check ([`CheckOutcome`]) and how far off its milestone the robot was (m).
+    pub last_outcome: u32,
+    pub last_off_m: f64,
+}
+crate::payloads::message!(PlanSketch);
+
+/// A subgoal's stages (`PlanSketch::stage`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum PlanStage {
+    Developing = 0,
+    /// Turning to face the milestone, then fixing the pose.
+    Aiming = 1,
+    Moving = 2,
+    /// At the milestone: fixing the pose to check it.
+    Arriving = 3,
+    Checking = 4,
+    /// The goal is reached: taking its heading.
+    Settling = 5,
+    Arrived = 6,
+}
+
+/// How a milestone check came out (`PlanSketch::last_outcome`; 0 before the first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum CheckOutcome {
+    Reached = 1,
+    /// Missed by a little: the subgoal is retried from the last known location (plan level).
+    Retried = 2,
+    /// Missed by a lot, or too often: the plan is developed afresh from there (goal level).
+    Replanned = 3,
+}

@@ -3,8 +3,9 @@
 use core::marker::PhantomData;
 
 use crate::{
-    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry, PoseFix,
-    Progress, ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult,
+    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry,
+    PlanSketch, PoseFix, Progress, ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap,
+    VisionRequest, VisionResult,
 };
 
 /// Queue sizing of a topic. Every process opening the topic uses the same numbers, so the
@@ -76,6 +77,7 @@ pub const UMS_EXPECTATIONS: Topic<Expectation> = Topic::new("ums/expectations", 
 pub const EXECUTIVE_STATUS: Topic<MissionStatus> = Topic::new("executive/status", Qos::STATE);
 pub const EXECUTIVE_SERVO: Topic<ServoCorrection> = Topic::new("executive/servo", Qos::STATE);
 pub const EXECUTIVE_POSE: Topic<PoseFix> = Topic::new("executive/pose", Qos::STATE);
+pub const EXECUTIVE_PLAN: Topic<PlanSketch> = Topic::new("executive/plan", Qos::STATE);
 pub const VISION_REQUESTS: Topic<VisionRequest> = Topic::new("vision/requests", Qos::STATE);
 pub const VISION_RESULTS: Topic<VisionResult> = Topic::new("vision/results", Qos::STATE);
 pub const CAMERA_FRAME: FrameTopic = FrameTopic { name: "camera/frame", qos: Qos::FRAMES };
@@ -104,6 +106,7 @@ pub const ALL: &[&str] = &[
     EXECUTIVE_STATUS.name,
     EXECUTIVE_SERVO.name,
     EXECUTIVE_POSE.name,
+    EXECUTIVE_PLAN.name,
     VISION_REQUESTS.name,
     VISION_RESULTS.name,
     CAMERA_FRAME.name,

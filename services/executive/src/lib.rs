@@ -14,11 +14,11 @@ pub mod refining;
 pub mod schemas;
 pub mod servo;
 
-use harvey_msgs::PoseFix;
 use harvey_msgs::{
     CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2, ServoCorrection,
     ServoLevel, VisionRequest, VisionResult, VisionStatus,
 };
+use harvey_msgs::{PlanSketch, PoseFix};
 use leg::{Leg, LegStep, ServoSetup};
 use mission::{Mission, Step};
 
@@ -30,6 +30,7 @@ pub enum Output {
     Look(VisionRequest),
     Servo(ServoCorrection),
     Pose(PoseFix),
+    Plan(PlanSketch),
 }
 
 /// The executive's vision request ids start here (the vision workers' own standing requests
@@ -90,6 +91,7 @@ pub struct Executive {
     pub fixes: u32,
     /// Plan-and-monitor, when the mission is a `ptrans` goal: it appends the steps.
     pub plan: Option<monitor::Monitor>,
+    plan_seq: u64,
     odometry: Pose2,
     belief: Option<(Pose2, Pose2)>,
     /// Times a reflex interrupted the mission.
@@ -147,6 +149,7 @@ impl Executive {
             looks: Vec::new(),
             fixes: 0,
             plan: None,
+            plan_seq: 0,
             odometry: Pose2::default(),
             belief: None,
             preemptions: 0,
@@ -263,22 +266,22 @@ impl Executive {
     /// Plan-and-monitor's next steps, appended to the script and begun.
     fn plan_next(&mut self, at: Pose2, now: u64) -> Vec<Output> {
         let Some(plan) = self.plan.as_mut() else { return Vec::new() };
-        match plan.next(at, self.fixes) {
+        let next = plan.next(at, self.fixes);
+        self.plan_seq += 1;
+        let mut out = vec![Output::Plan(plan.sketch_msg(self.plan_seq, now))];
+        match next {
             Ok(monitor::Next::Steps(steps)) => {
                 let first = self.mission.steps.len();
                 self.mission.steps.extend(steps);
-                self.begin(first, at, now)
+                out.extend(self.begin(first, at, now));
             }
-            Ok(monitor::Next::Arrived) => {
-                self.phase = Phase::Done(MissionState::Succeeded);
-                Vec::new()
-            }
+            Ok(monitor::Next::Arrived) => self.phase = Phase::Done(MissionState::Succeeded),
             Err(e) => {
                 tracing::error!(error = %e, "plan-and-monitor failed");
                 self.phase = Phase::Done(MissionState::Failed);
-                Vec::new()
             }
         }
+        out
     }
 
     /// The next primitive of the way back to the interrupted step's goal, or the next step.

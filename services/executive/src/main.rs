@@ -136,6 +136,7 @@ fn main() -> anyhow::Result<()> {
     let requests = bus.publisher(topics::VISION_REQUESTS)?;
     let servo_pub = bus.publisher(topics::EXECUTIVE_SERVO)?;
     let pose_pub = bus.publisher(topics::EXECUTIVE_POSE)?;
+    let plan_pub = bus.publisher(topics::EXECUTIVE_PLAN)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps, &results])?;
@@ -190,6 +191,9 @@ fn main() -> anyhow::Result<()> {
                 }
                 Output::Pose(p) => {
                     pose_pub.send(p)?;
+                }
+                Output::Plan(p) => {
+                    plan_pub.send(p)?;
                 }
             }
         }

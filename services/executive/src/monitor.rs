@@ -5,7 +5,7 @@
 //! returns success, or failure with the last known location: a small miss is retried from there
 //! (plan level), a large one or a repeated one re-develops the plan from there (goal level).
 
-use harvey_msgs::Pose2;
+use harvey_msgs::{CheckOutcome, Header, PlanSketch, PlanStage, Pose2, SKETCH_PLACES};
 use harvey_world::World;
 
 use crate::mission::{PtransGoal, Step};
@@ -214,6 +214,40 @@ impl Monitor {
                 Stage::Settle | Stage::Finish => self.stage = Stage::Aim,
             }
         }
+    }
+
+    /// The sketch and the latest check, to publish (places past `SKETCH_PLACES` are left out).
+    pub fn sketch_msg(&self, seq: u64, stamp_ns: u64) -> PlanSketch {
+        let mut m = PlanSketch { header: Header::new(seq, stamp_ns), ..PlanSketch::default() };
+        let places =
+            self.sketch.first().map(|p| &p.from).into_iter().chain(self.sketch.iter().map(|p| &p.to));
+        for (k, place) in places.take(SKETCH_PLACES).enumerate() {
+            (m.places_m[2 * k], m.places_m[2 * k + 1]) = (place.at[0], place.at[1]);
+            m.place_count += 1;
+        }
+        for (k, p) in self.sketch.iter().enumerate().take(SKETCH_PLACES - 1) {
+            m.primitive_mask |= u32::from(p.primitive) << k;
+        }
+        m.stage = match self.stage {
+            Stage::Develop => PlanStage::Developing,
+            Stage::Aim => PlanStage::Aiming,
+            Stage::Go => PlanStage::Moving,
+            Stage::Arrive { .. } => PlanStage::Arriving,
+            Stage::Check { .. } => PlanStage::Checking,
+            Stage::Settle => PlanStage::Settling,
+            Stage::Finish => PlanStage::Arrived,
+        } as u32;
+        m.checks = self.checks.len() as u32;
+        m.replans = self.replans;
+        if let Some(c) = self.checks.last() {
+            m.last_outcome = match c.outcome {
+                Outcome::Reached => CheckOutcome::Reached,
+                Outcome::Retried => CheckOutcome::Retried,
+                Outcome::Replanned => CheckOutcome::Replanned,
+            } as u32;
+            m.last_off_m = c.off_m;
+        }
+        m
     }
 
     /// How near the current subgoal's milestone counts as there.

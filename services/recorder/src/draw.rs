@@ -35,6 +35,7 @@ draw_with!(
     MissionStatus => status,
     ServoCorrection => servo,
     harvey_msgs::PoseFix => pose_fix,
+    harvey_msgs::PlanSketch => plan,
     Detections => detections,
     VisionResult => vision_result,
 );

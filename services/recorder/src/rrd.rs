@@ -46,6 +46,8 @@ pub struct RrdWriter {
     camera: Option<(f64, f64, f64)>,
     /// Stamp of each landmark's latest Expecter window: windows not renewed are cleared.
     windows: std::collections::BTreeMap<u32, u64>,
+    /// Milestone checks already logged.
+    plan_checks: u32,
 }
 
 /// A window not renewed for this long (message time) is taken off the image.
@@ -81,6 +83,7 @@ impl RrdWriter {
             goal: None,
             camera,
             windows: Default::default(),
+            plan_checks: 0,
         };
         if let Some(world) = world {
             w.draw_world(world)?;

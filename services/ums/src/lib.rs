@@ -1,10 +1,12 @@
 //! The uncertainty management subsystem (002 ch. VII) as a state machine: odometry grows the map
 //! turn by turn and run by run (§3.3), landmark sightings slice it (§3.4) at their own time
 //! stamps — a late sighting is applied to the map as it was then and the growth since replayed —
-//! the Expecter publishes where each active landmark must appear (§4, §5.1), and the map reports
-//! "lost" when it grows too large or predicted landmarks go missing.
+//! the Expecter publishes where each active landmark must appear (§4, §5.1), the executive's pose
+//! fixes (000 §5.6) shrink it to a small region, and the map reports "lost" when it grows too
+//! large or predicted landmarks go missing.
 
 pub mod expecter;
+mod fix;
 pub mod geometry;
 pub mod map;
 pub mod reduction;
@@ -32,6 +34,10 @@ pub struct Config {
     /// How long a sighting may lag the odometry and still be applied at its own stamp.
     pub history_ns: u64,
     pub image_px: (u32, u32),
+    /// How well a pose fix from landmark vertices places the robot: half the side of the square
+    /// round the fixed position (m), and the heading either way (rad).
+    pub fix_m: f64,
+    pub fix_heading_rad: f64,
 }
 
 /// Pixels added around a window for the strategy that searches it: a correlation template's
@@ -205,13 +211,25 @@ impl Ums {
             to: l.to_m.map(|t| [t[0], t[1]]),
             position_sd_m: l.position_sd_m,
         };
-        // The map as it was at the sighting's stamp; then the growth since, replayed.
-        let i = self.history.iter().rposition(|(t, ..)| *t <= s.header.stamp_ns).ok_or(format!(
-            "sighting of `{}` at {} ns is older than the map's history: stamps out of order",
-            l.name, s.header.stamp_ns
-        ))?;
-        let mut m = reduction::apply(&self.history[i].1, &known, &obs, self.config.sigmas)
-            .map_err(|e| format!("sighting of `{}`: {e}", l.name))?;
+        let (sigmas, name) = (self.config.sigmas, l.name.clone());
+        self.rewrite_at(s.header.stamp_ns, &format!("sighting of `{name}`"), |then| {
+            reduction::apply(then, &known, &obs, sigmas).map_err(|e| format!("sighting of `{name}`: {e}"))
+        })
+    }
+
+    /// Replaces the map as it was at `stamp_ns` by `change` of it, then replays the growth since
+    /// (a late observation applies at its own time).
+    fn rewrite_at(
+        &mut self,
+        stamp_ns: u64,
+        what: &str,
+        change: impl FnOnce(&Map) -> Result<Map, String>,
+    ) -> Result<(), String> {
+        let i =
+            self.history.iter().rposition(|(t, ..)| *t <= stamp_ns).ok_or(format!(
+                "{what} at {stamp_ns} ns is older than the map's history: stamps out of order"
+            ))?;
+        let mut m = change(&self.history[i].1)?;
         self.history[i].1 = m.clone();
         for j in i + 1..self.history.len() {
             let step = self.history[j].2;

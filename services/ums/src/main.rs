@@ -27,6 +27,12 @@ struct Args {
     /// mission's own start).
     #[arg(long)]
     start: Option<harvey_world::Pose>,
+    /// A pose fix places the robot within this square's half side (m)…
+    #[arg(long, default_value_t = 0.05)]
+    fix_m: f64,
+    /// …and its heading within this either way (degrees).
+    #[arg(long, default_value_t = 0.5)]
+    fix_heading_deg: f64,
     /// How late a sighting may arrive and still be applied at its own stamp.
     #[arg(long, default_value_t = 2000)]
     history_ms: u64,
@@ -50,23 +56,32 @@ fn main() -> anyhow::Result<()> {
         lost_after_misses: args.lost_after_misses,
         history_ns: args.history_ms * 1_000_000,
         image_px,
+        fix_m: args.fix_m,
+        fix_heading_rad: args.fix_heading_deg.to_radians(),
     };
     let bus = Bus::join("ums")?;
     let odometry = bus.subscriber(topics::ODOMETRY)?;
     let sightings = bus.subscriber(topics::VISION_SIGHTINGS)?;
+    let fixes = bus.subscriber(topics::EXECUTIVE_POSE)?;
     let map_pub = bus.publisher(topics::UMS_MAP)?;
     let expectations = bus.publisher(topics::UMS_EXPECTATIONS)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let _a = pace.attach(&waiter, &[&odometry, &sightings])?;
+    let _a = pace.attach(&waiter, &[&odometry, &sightings, &fixes])?;
     harvey_runtime::notify_ready()?;
 
     let mut ums = Ums::new(world, config);
-    let (mut odos, mut seen) = (Vec::new(), Vec::new());
+    let (mut odos, mut seen, mut fixed) = (Vec::new(), Vec::new(), Vec::new());
     while pace.next(&waiter, None)? != Step::Stop {
         sightings.drain_into(&mut seen)?;
         for s in &seen {
             if let Err(e) = ums.on_sighting(s) {
+                tracing::warn!("rejected: {e}");
+            }
+        }
+        fixes.drain_into(&mut fixed)?;
+        for f in &fixed {
+            if let Err(e) = ums.on_fix(f) {
                 tracing::warn!("rejected: {e}");
             }
         }

@@ -16,6 +16,8 @@ fn ums() -> Ums {
         lost_after_misses: 2,
         history_ns: 2_000_000_000,
         image_px: (640, 480),
+        fix_m: 0.05,
+        fix_heading_rad: 0.01,
     };
     Ums::new(hallway(), config)
 }
@@ -131,4 +133,29 @@ fn too_large_a_map_or_missed_landmarks_mean_lost() {
     let out = far.on_odometry(&odo(50, 6.0)).expect("ok");
     assert!(map_of(&out).area_m2 > 0.05);
     assert_eq!(map_of(&out).lost, 1, "area over the limit");
+}
+
+#[test]
+fn a_pose_fix_shrinks_the_map_at_its_stamp_and_a_bad_one_is_refused() {
+    let mut u = ums();
+    for k in 0..=20 {
+        u.on_odometry(&odo(100 * k, 0.25 * k as f64)).expect("odometry");
+    }
+    let grown = u.map().area_m2();
+    assert!(grown > 0.01, "{grown}");
+    // Fixed at 1.5 s (3.75 m travelled) to 4 cm to the left of the odometry's line.
+    let fix = harvey_msgs::PoseFix {
+        header: Header::new(1, 1_500_000_000),
+        refined: harvey_msgs::Pose2 { x_m: 3.75, y_m: 0.04, heading_rad: 0.0 },
+        ..Default::default()
+    };
+    u.on_fix(&fix).expect("applies");
+    // A 10 cm square then, grown over the 1.25 m since: far smaller than before.
+    let fixed = u.map().area_m2();
+    assert!(fixed < grown / 4.0 && fixed > 0.01, "{fixed} against {grown}");
+    let c = u.map().centre;
+    assert!((c[0] - 5.0).abs() < 0.1 && (c[1] - 0.04).abs() < 0.01, "{c:?}");
+    let bad = harvey_msgs::PoseFix { refined: harvey_msgs::Pose2 { x_m: f64::NAN, ..fix.refined }, ..fix };
+    assert!(u.on_fix(&bad).expect_err("refused").contains("non-finite"));
+    assert_eq!(u.map().area_m2(), fixed);
 }

@@ -1,8 +1,10 @@
 //! How the executive's own working is drawn: each action-level correction as plots (heading
 //! error, turn, estimated offset from the line) and a log line; each pose refinement as the
-//! expected and refined poses in the world view and a log line.
+//! expected and refined poses in the world view and a log line; the plan sketch as a path
+//! through its milestones (solid where primitive, faint where still abstract), with each
+//! milestone check in the log.
 
-use harvey_msgs::{PoseFix, ServoCorrection};
+use harvey_msgs::{CheckOutcome, PlanSketch, PoseFix, ServoCorrection};
 
 use super::RrdWriter;
 use crate::RecordError;
@@ -52,5 +54,49 @@ impl RrdWriter {
         self.rec
             .log("log", &rerun::TextLog::new(text).with_level(rerun::TextLogLevel::INFO))
             .map_err(|e| self.err(e))
+    }
+
+    pub fn plan(&mut self, p: &PlanSketch) -> Result<(), RecordError> {
+        self.at(p.header.stamp_ns);
+        let n = (p.place_count as usize).min(harvey_msgs::SKETCH_PLACES);
+        let places: Vec<[f32; 2]> =
+            (0..n).map(|k| super::up([p.places_m[2 * k], p.places_m[2 * k + 1]])).collect();
+        let (mut detailed, mut abstract_) = (Vec::new(), Vec::new());
+        for k in 0..n.saturating_sub(1) {
+            let leg = vec![places[k], places[k + 1]];
+            if p.primitive_mask & (1 << k) != 0 { detailed.push(leg) } else { abstract_.push(leg) }
+        }
+        let strips = [
+            ("world/plan/primitive", detailed, rerun::Color::from_rgb(60, 200, 120)),
+            ("world/plan/abstract", abstract_, rerun::Color::from_unmultiplied_rgba(60, 200, 120, 90)),
+        ];
+        for (path, legs, colour) in strips {
+            self.rec
+                .log(path, &rerun::LineStrips2D::new(legs).with_colors([colour]))
+                .map_err(|e| self.err(e))?;
+        }
+        let milestones = rerun::Points2D::new(places.iter().skip(1).copied())
+            .with_radii([0.06])
+            .with_colors([rerun::Color::from_rgb(60, 200, 120)]);
+        self.rec.log("world/plan/milestones", &milestones).map_err(|e| self.err(e))?;
+        self.rec
+            .log("plots/plan_stage", &rerun::Scalars::single(f64::from(p.stage)))
+            .map_err(|e| self.err(e))?;
+        if p.checks == self.plan_checks || p.last_outcome == 0 {
+            return Ok(());
+        }
+        self.plan_checks = p.checks;
+        let (what, level) = match p.last_outcome {
+            o if o == CheckOutcome::Reached as u32 => ("reached", rerun::TextLogLevel::INFO),
+            o if o == CheckOutcome::Retried as u32 => {
+                ("missed: retried from here", rerun::TextLogLevel::WARN)
+            }
+            _ => ("missed: plan developed afresh", rerun::TextLogLevel::WARN),
+        };
+        let text = format!(
+            "milestone check {}: {what}, {:.3} m off ({} replans)",
+            p.checks, p.last_off_m, p.replans
+        );
+        self.rec.log("log", &rerun::TextLog::new(text).with_level(level)).map_err(|e| self.err(e))
     }
 }

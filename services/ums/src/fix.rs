@@ -1,0 +1,23 @@
+//! A pose fix from the executive's plan-level servoing (000 §5.6, `executive/pose`): landmark
+//! vertices placed the robot to within an inch or so, so at the fix's stamp the map becomes a
+//! small square round the refined position with a narrow heading wedge, and the growth since is
+//! replayed (the fix may arrive after later odometry).
+
+use harvey_msgs::PoseFix;
+
+use crate::Ums;
+use crate::map::Map;
+
+impl Ums {
+    /// Applies a pose fix; a fix holding a non-finite number is refused, the map untouched.
+    pub fn on_fix(&mut self, f: &PoseFix) -> Result<(), String> {
+        let p = f.refined;
+        if ![p.x_m, p.y_m, p.heading_rad].iter().all(|v| v.is_finite()) {
+            return Err(format!("pose fix at {} ns holds a non-finite number", f.header.stamp_ns));
+        }
+        let (r, h) = (self.config.fix_m, self.config.fix_heading_rad);
+        let square =
+            [[p.x_m - r, p.y_m - r], [p.x_m + r, p.y_m - r], [p.x_m + r, p.y_m + r], [p.x_m - r, p.y_m + r]];
+        self.rewrite_at(f.header.stamp_ns, "pose fix", |_| Ok(Map::region(&square, p.heading_rad, h, h)))
+    }
+}
