@@ -38,6 +38,8 @@ pub struct RunStats {
     /// Milestone checks by outcome (reached, retried, replanned), and pose fixes.
     pub checks: [u32; 3],
     pub fixes: u32,
+    /// The states a sequenced behaviour's acceptor went through.
+    pub fsa_trace: Vec<u32>,
 }
 
 impl RunStats {
@@ -62,6 +64,12 @@ impl RunStats {
                 "sim/truth" => run.last_truth = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
                 "ums/map" => run.last_map = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
                 "executive/pose" => run.fixes += 1,
+                "executive/behaviour" => {
+                    let b: harvey_msgs::BehaviourState = harvey_cdr::decode(&m.data).map_err(bad)?;
+                    if run.fsa_trace.last() != Some(&b.fsa_state) {
+                        run.fsa_trace.push(b.fsa_state);
+                    }
+                }
                 "executive/plan" => {
                     let p: PlanSketch = harvey_cdr::decode(&m.data).map_err(bad)?;
                     let checks_before = run.last_plan.map_or(0, |q| q.checks);
@@ -162,6 +170,10 @@ impl RunStats {
                 reached + retried + replanned,
                 self.fixes
             );
+        }
+        if !self.fsa_trace.is_empty() {
+            let trace: Vec<String> = self.fsa_trace.iter().map(|q| format!("q{q}")).collect();
+            out += &format!("  acceptor trace: {}\n", trace.join(" "));
         }
         out += &format!(
             "  data seen by the executive: {} sonar rings, {} detections, {} maps\n",

@@ -83,12 +83,15 @@ fn the_default_mission_runs_records_and_cleans_up() {
         }
     }
     // The sonar reflexes speak only when something is in the way (tests/panic_avoid.rs), the
-    // servoing only on servoed moves and refinements (tests/hallway.rs, tests/pose_refine.rs).
+    // servoing only on servoed moves and refinements (tests/hallway.rs, tests/pose_refine.rs),
+    // plan-and-monitor and the acceptor-sequenced behaviours only in their missions
+    // (tests/ptrans.rs, tests/docking.rs).
     let eventful = [
         topics::VEHICLE_REFLEX.name,
         topics::EXECUTIVE_SERVO.name,
         topics::EXECUTIVE_POSE.name,
         topics::EXECUTIVE_PLAN.name,
+        topics::EXECUTIVE_BEHAVIOUR.name,
     ];
     for t in topics::ALL.iter().filter(|t| !eventful.contains(t)) {
         assert!(counts.get(*t).copied().unwrap_or(0) > 0, "no message on {t}: {counts:?}");

@@ -1,6 +1,7 @@
 //! What the executive publishes about its own working besides its mission status: the servoing
 //! level it is at, each action-level correction (`executive/servo`, 000 §5.5), each plan-level
-//! pose refinement (`executive/pose`, 000 §5.6) and its plan sketch (`executive/plan`, 000 §2).
+//! pose refinement (`executive/pose`, 000 §5.6), its plan sketch (`executive/plan`, 000 §2) and
+//! the state of a behaviour sequenced by a finite state acceptor (`executive/behaviour`, 004).
 
 use crate::{Header, Message, Pose2, ZeroCopySend};
 
@@ -117,3 +118,28 @@ pub enum CheckOutcome {
     /// Missed by a lot, or too often: the plan is developed afresh from there (goal level).
     Replanned = 3,
 }
+
+/// A behaviour under a finite state acceptor (004 §3): the acceptor's state, the last trigger,
+/// and the motor schemas' velocity vectors this tick (004 §2.1), once per odometry tick.
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[repr(C)]
+#[type_name("harvey_msgs/BehaviourState")]
+pub struct BehaviourState {
+    pub header: Header,
+    /// The pose the vectors start from (the executive's belief).
+    pub at: Pose2,
+    /// Index of the acceptor's state (`q0` = 0 …) and the transitions taken so far.
+    pub fsa_state: u32,
+    pub transitions: u32,
+    /// The latest trigger: 0 normal, 1 terminal, 2 recoverable error, 3 fatal error.
+    pub last_trigger: u32,
+    /// Things the behaviour has reached so far (poles parked by; 1 once docked).
+    pub achieved: u32,
+    /// World-frame vectors (m/s), `x y` each: move-to-goal, avoid-static-obstacle, noise,
+    /// avoid-past, probe, and their clipped sum.
+    pub vectors_mps: [f64; 12],
+    /// The velocity command sent: speed (m/s) and turn rate (rad/s).
+    pub linear_mps: f64,
+    pub angular_radps: f64,
+}
+crate::payloads::message!(BehaviourState);

@@ -3,8 +3,8 @@
 use core::marker::PhantomData;
 
 use crate::{
-    Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand, Odometry,
-    PlanSketch, PoseFix, Progress, ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap,
+    BehaviourState, Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand,
+    Odometry, PlanSketch, PoseFix, Progress, ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap,
     VisionRequest, VisionResult,
 };
 
@@ -78,6 +78,7 @@ pub const EXECUTIVE_STATUS: Topic<MissionStatus> = Topic::new("executive/status"
 pub const EXECUTIVE_SERVO: Topic<ServoCorrection> = Topic::new("executive/servo", Qos::STATE);
 pub const EXECUTIVE_POSE: Topic<PoseFix> = Topic::new("executive/pose", Qos::STATE);
 pub const EXECUTIVE_PLAN: Topic<PlanSketch> = Topic::new("executive/plan", Qos::STATE);
+pub const EXECUTIVE_BEHAVIOUR: Topic<BehaviourState> = Topic::new("executive/behaviour", Qos::STATE);
 pub const VISION_REQUESTS: Topic<VisionRequest> = Topic::new("vision/requests", Qos::STATE);
 pub const VISION_RESULTS: Topic<VisionResult> = Topic::new("vision/results", Qos::STATE);
 pub const CAMERA_FRAME: FrameTopic = FrameTopic { name: "camera/frame", qos: Qos::FRAMES };
@@ -107,6 +108,7 @@ pub const ALL: &[&str] = &[
     EXECUTIVE_SERVO.name,
     EXECUTIVE_POSE.name,
     EXECUTIVE_PLAN.name,
+    EXECUTIVE_BEHAVIOUR.name,
     VISION_REQUESTS.name,
     VISION_RESULTS.name,
     CAMERA_FRAME.name,

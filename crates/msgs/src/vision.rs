@@ -38,12 +38,21 @@ pub enum VisionAlgorithm {
     /// `params[1]` (`params[0]` = 1, default threshold 20). Item: `[cx, cy, strength, 0, 0, 0]`,
     /// from the second frame on.
     Activity = 6,
+    /// The constrained Hough transform's dock recognition (004 §4.1.2): fast-line-finder lines
+    /// of the window vote for the 2 x 1 frame-with-post model (`DockModel::frame_with_post`,
+    /// half a model unit a side) under `params[2]` scale hypotheses (default 5) spread evenly
+    /// from `params[0]` to `params[1]` pixels per model unit (the range the requester's spatial
+    /// uncertainty allows), image rotation `params[3]` (radians). A match covering less than
+    /// `params[4]` of the model (default 0.5) is not found. Item: `[u, v, certainty, scale,
+    /// left, right]`: the model's reference point (the frame's centre), the winning scale, and
+    /// the apparent heights of its end posts (pixels, 0 where not seen; `hough::post_heights`).
+    Dock = 7,
 }
 
 impl VisionAlgorithm {
     pub fn from_raw(raw: u32) -> Option<Self> {
         use VisionAlgorithm::*;
-        [Correlate, Moravec, LineFinder, RegionSegmenter, Phototropic, Activity]
+        [Correlate, Moravec, LineFinder, RegionSegmenter, Phototropic, Activity, Dock]
             .into_iter()
             .find(|a| *a as u32 == raw)
     }

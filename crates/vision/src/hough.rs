@@ -166,6 +166,27 @@ fn coverage(lines: &[Line], model: &DockModel, h: &Hypothesis, at: [f32; 2]) -> 
     covered
 }
 
+/// The apparent heights (pixels) of the frame's end posts, left then right, for a match at `at`
+/// with `scale` pixels per model unit: the longest near-vertical line near each post (0 where
+/// none). A frame turned away shows its far post shorter: with the posts' true height and
+/// spacing this gives the angle it is seen at (the inverse perspective cue of 004 §4.1.3).
+pub fn post_heights(lines: &[Line], at: [f32; 2], scale: f32) -> [f32; 2] {
+    let mut out = [0.0f32; 2];
+    for (k, side) in [-1.0f32, 1.0].into_iter().enumerate() {
+        let post_u = at[0] + side * scale;
+        out[k] = lines
+            .iter()
+            .filter(|l| (l.orientation_deg - 90.0).abs() < 10.0)
+            .filter(|l| {
+                let mid = [(l.from[0] + l.to[0]) / 2.0, (l.from[1] + l.to[1]) / 2.0];
+                (mid[0] - post_u).abs() < 0.25 * scale && (mid[1] - at[1]).abs() < 0.35 * scale
+            })
+            .map(|l| l.length)
+            .fold(0.0, f32::max);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -232,5 +253,20 @@ mod tests {
         assert_eq!(hyps[m.hypothesis].scale, 40.0, "{m:?}");
         let none = find_dock(&scene(truth, 41.0, 0.06, false), &dock(), &hyps, [640, 480], 4.0);
         assert!(none.is_none_or(|m| m.certainty < 0.3), "{none:?}");
+    }
+
+    #[test]
+    fn the_posts_heights_are_read_from_the_lines_near_them() {
+        // Left post 60 px tall, right post 66 px (the right is nearer), both broken by noise into
+        // a long and a short piece; a vertical line elsewhere is ignored.
+        let lines = [
+            line([100.0, 170.0], [100.0, 230.0]),
+            line([100.0, 150.0], [100.0, 160.0]),
+            line([220.0, 167.0], [220.0, 233.0]),
+            line([160.0, 100.0], [160.0, 300.0]),
+            line([215.0, 200.0], [240.0, 200.0]),
+        ];
+        assert_eq!(post_heights(&lines, [160.0, 200.0], 60.0), [60.0, 66.0]);
+        assert_eq!(post_heights(&lines, [400.0, 200.0], 60.0), [0.0, 0.0]);
     }
 }

@@ -3,6 +3,8 @@
 //! action-level servoing on a landmark after each (`leg.rs`, 000 §5.5). Plan-and-monitor and FSA
 //! sequencing grow from here.
 
+pub mod docking;
+pub mod drive;
 pub mod fsa;
 pub mod leg;
 pub mod mission;
@@ -14,11 +16,11 @@ pub mod refining;
 pub mod schemas;
 pub mod servo;
 
+use harvey_msgs::{BehaviourState, PlanSketch, PoseFix, SonarRing};
 use harvey_msgs::{
     CommandKind, Header, MissionState, MissionStatus, MotionCommand, Odometry, Pose2, ServoCorrection,
     ServoLevel, VisionRequest, VisionResult, VisionStatus,
 };
-use harvey_msgs::{PlanSketch, PoseFix};
 use leg::{Leg, LegStep, ServoSetup};
 use mission::{Mission, Step};
 
@@ -31,6 +33,7 @@ pub enum Output {
     Servo(ServoCorrection),
     Pose(PoseFix),
     Plan(PlanSketch),
+    Behaviour(BehaviourState),
 }
 
 /// The executive's vision request ids start here (the vision workers' own standing requests
@@ -92,6 +95,8 @@ pub struct Executive {
     /// Plan-and-monitor, when the mission is a `ptrans` goal: it appends the steps.
     pub plan: Option<monitor::Monitor>,
     plan_seq: u64,
+    /// An acceptor-sequenced docking behaviour, when the mission is one.
+    pub docking: Option<docking::Docking>,
     odometry: Pose2,
     belief: Option<(Pose2, Pose2)>,
     /// Times a reflex interrupted the mission.
@@ -128,6 +133,20 @@ impl Executive {
         self
     }
 
+    /// With the docking behaviour driving the robot.
+    pub fn with_docking(mut self, d: docking::Docking) -> Self {
+        self.docking = Some(d);
+        self
+    }
+
+    /// A sonar ring (the behaviours' obstacles and ranges).
+    pub fn on_sonar(&mut self, r: &SonarRing) {
+        self.sonar_rings_seen += 1;
+        if let Some(d) = self.docking.as_mut() {
+            d.on_sonar(r);
+        }
+    }
+
     /// With plan-and-monitor developing the mission's `ptrans` goal.
     pub fn with_plan(mut self, monitor: monitor::Monitor) -> Self {
         self.plan = Some(monitor);
@@ -150,6 +169,7 @@ impl Executive {
             fixes: 0,
             plan: None,
             plan_seq: 0,
+            docking: None,
             odometry: Pose2::default(),
             belief: None,
             preemptions: 0,
@@ -295,6 +315,10 @@ impl Executive {
 
     /// A vision result: the answer to the leg's look, if it is the one awaited.
     pub fn on_vision(&mut self, r: &VisionResult) -> Vec<Output> {
+        if let Some(d) = self.docking.as_mut() {
+            d.on_vision(r);
+            return Vec::new();
+        }
         if matches!(self.phase, Phase::Refining { .. }) {
             return self.on_refine_result(r);
         }
@@ -333,7 +357,26 @@ impl Executive {
         self.estimated = self.believed();
         let at = self.estimated;
         let mut out = Vec::new();
+        if let Some(d) = self.docking.as_mut() {
+            if matches!(self.phase, Phase::Waiting) {
+                self.start_ns = now;
+                self.goal = d.goal_pose();
+                self.phase = Phase::Executing { step: 0, id: 0 };
+            }
+            if !matches!(self.phase, Phase::Done(_)) {
+                let (look, command, state) = d.on_odometry(at, now);
+                self.estimated = d.believed();
+                out.extend(look.map(Output::Look));
+                out.push(Output::Command(command));
+                out.push(Output::Behaviour(state));
+                if let Some(docked) = d.done {
+                    self.phase =
+                        Phase::Done(if docked { MissionState::Succeeded } else { MissionState::Failed });
+                }
+            }
+        }
         match self.phase {
+            _ if self.docking.is_some() => {}
             Phase::Waiting => {
                 self.start_ns = now;
                 match &self.plan {
@@ -452,6 +495,7 @@ mod tests {
             servo: None,
             refine: None,
             ptrans: None,
+            docking: None,
             steps: vec![
                 Step { move_m: Some(2.0), ..Step::default() },
                 Step { turn_deg: Some(90.0), ..Step::default() },

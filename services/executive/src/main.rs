@@ -7,6 +7,8 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
+use harvey_executive::docking::Docking;
+use harvey_executive::fsa::Fsa;
 use harvey_executive::leg::ServoSetup;
 use harvey_executive::mission::Mission;
 use harvey_executive::monitor::Monitor;
@@ -26,6 +28,9 @@ struct Args {
     /// The world file (needed by missions that servo on landmarks).
     #[arg(long)]
     world: Option<PathBuf>,
+    /// Seed of the noise motor schema.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
 }
 
 /// How each step servos: its landmark looked up in the world, the camera from its calibration.
@@ -101,6 +106,24 @@ fn refine_setup(m: &Mission, world: Option<&World>) -> anyhow::Result<Option<Ref
     }))
 }
 
+/// The docking behaviour: its acceptor (a file next to the launch file), the camera, the sonar.
+fn docking_setup(m: &Mission, world: Option<&World>, args: &Args) -> anyhow::Result<Option<Docking>> {
+    let Some(g) = &m.docking else { return Ok(None) };
+    let w = world.context("[mission.docking] needs --world")?;
+    let path = args.mission.parent().unwrap_or(std::path::Path::new(".")).join(&g.fsa);
+    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let fsa = Fsa::parse(&text, &path.display().to_string()).map_err(anyhow::Error::msg)?;
+    anyhow::ensure!(
+        fsa.states.iter().any(|s| s.name == g.docked_state),
+        "{}: no state {} (mission.docking.docked_state)",
+        path.display(),
+        g.docked_state
+    );
+    let c = &w.camera;
+    let camera = (c.focal_for(c.width_px), f64::from(c.width_px), f64::from(c.height_px));
+    Ok(Some(Docking::new(g.clone(), fsa, camera, w.robot.sonar_ring_radius_m, args.seed)))
+}
+
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
@@ -123,6 +146,7 @@ fn main() -> anyhow::Result<()> {
         }
         None => None,
     };
+    let docking = docking_setup(&mission, world.as_ref(), &args)?;
     tracing::info!(description = %mission.description, steps = mission.steps.len(), "mission loaded");
 
     let bus = Bus::join("executive")?;
@@ -136,6 +160,7 @@ fn main() -> anyhow::Result<()> {
     let requests = bus.publisher(topics::VISION_REQUESTS)?;
     let servo_pub = bus.publisher(topics::EXECUTIVE_SERVO)?;
     let pose_pub = bus.publisher(topics::EXECUTIVE_POSE)?;
+    let behaviour_pub = bus.publisher(topics::EXECUTIVE_BEHAVIOUR)?;
     let plan_pub = bus.publisher(topics::EXECUTIVE_PLAN)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
@@ -149,14 +174,20 @@ fn main() -> anyhow::Result<()> {
     if let Some(goal) = exec_goal {
         exec = exec.with_plan(goal);
     }
-    let (mut odos, mut seen) = (Vec::new(), Vec::new());
+    if let Some(d) = docking {
+        exec = exec.with_docking(d);
+    }
+    let (mut odos, mut seen, mut rings) = (Vec::new(), Vec::new(), Vec::new());
     let mut out = Vec::new();
     while exec.state() == MissionState::Running {
         if pace.next(&waiter, None)? == Step::Stop {
             tracing::warn!("stopped before the mission ended");
             return Ok(());
         }
-        exec.sonar_rings_seen += sonar.drain(|_| {})? as u64;
+        sonar.drain_into(&mut rings)?;
+        for r in &rings {
+            exec.on_sonar(r);
+        }
         exec.detections_seen += detections.drain(|_| {})? as u64;
         exec.maps_seen += maps.drain(|_| {})? as u64;
         results.drain_into(&mut seen)?;
@@ -194,6 +225,9 @@ fn main() -> anyhow::Result<()> {
                 }
                 Output::Plan(p) => {
                     plan_pub.send(p)?;
+                }
+                Output::Behaviour(b) => {
+                    behaviour_pub.send(b)?;
                 }
             }
         }

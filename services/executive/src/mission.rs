@@ -85,6 +85,65 @@ pub struct PtransGoal {
     pub back_off_m: f64,
 }
 
+/// A docking behaviour sequenced by a finite state acceptor (`[mission.docking]`, 004 §4.2).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DockingGoal {
+    /// The acceptor's file, relative to the launch file (`fsa/docking.toml`), and the accepting
+    /// state that means docked (the other accepting states are failures).
+    pub fsa: String,
+    pub docked_state: String,
+    /// The dock face's centre on the floor and the way the face looks (degrees).
+    pub dock_m: [f64; 2],
+    pub dock_facing_deg: f64,
+    /// The Hough model: the frame's width (m; the model is 2 units wide) and its centre's height.
+    pub frame_width_m: f64,
+    pub frame_height_m: f64,
+    /// The tracking target: a square of this side, its centre's height, its grey levels.
+    pub target_side_m: f64,
+    pub target_height_m: f64,
+    pub target_grey: [f64; 2],
+    /// The phototropic cue counts only a region this bright (grey level): with the lamp hidden,
+    /// the brightest thing in view is something else.
+    pub light_min_grey: f64,
+    /// The Hough is tried once the dock is believed this near, give or take (scale hypotheses),
+    /// with matches covering at least this share of the model; after a failure, once the robot
+    /// has moved this far for a new view.
+    pub hough_range_m: f64,
+    pub hough_range_sd_m: f64,
+    pub hough_min_certainty: f64,
+    pub retry_after_m: f64,
+    /// Tracking steers for the dock's axis this far ahead of the robot (the approach zone), and
+    /// hands over to the sonar when the target covers this many pixels.
+    pub lead_m: f64,
+    /// Controlled motion keeps within this of the target's bearing (degrees), so that the
+    /// target stays in the image.
+    pub keep_in_view_deg: f64,
+    pub close_area_px: f64,
+    /// While tracking, every this many ticks a fix from the Hough's frame, while the robot is
+    /// further than `fix_beyond_m` from the face (nearer, the frame leaves the image).
+    pub fix_every_ticks: u32,
+    pub fix_beyond_m: f64,
+    /// After the first, a fix further than these from the belief is taken as a misreading.
+    pub fix_gate_m: f64,
+    pub fix_gate_deg: f64,
+    /// Docked when the robot's centre is this far from the face; closer than `too_close_m` is
+    /// a fatal error.
+    pub final_m: f64,
+    pub too_close_m: f64,
+    /// Ballistic and controlled speeds (m/s), turn rate limit (degrees/s) and gain (per second).
+    pub ballistic_mps: f64,
+    pub controlled_mps: f64,
+    pub max_turn_degps: f64,
+    pub turn_gain: f64,
+    /// avoid-static-obstacle's sphere of influence beyond the robot (m) and gain (m/s); the
+    /// noise schema's size (m/s) and how many ticks each direction is held.
+    pub avoid_sphere_m: f64,
+    pub avoid_gain: f64,
+    pub noise_mps: f64,
+    pub noise_ticks: u32,
+}
+
 /// The `[mission]` table of a launch file.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -97,6 +156,7 @@ pub struct Mission {
     pub servo: Option<Servo>,
     pub refine: Option<Refine>,
     pub ptrans: Option<PtransGoal>,
+    pub docking: Option<DockingGoal>,
 }
 
 #[derive(Deserialize)]
@@ -114,15 +174,25 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
     if !greater(m.timeout_s, 0.0) {
         return Err(format!("{file}: mission.timeout_s must be positive"));
     }
-    match &m.ptrans {
-        None if m.steps.is_empty() => {
-            return Err(format!("{file}: the mission has no [[mission.step]] and no [mission.ptrans]"));
+    let behaviours = usize::from(m.ptrans.is_some()) + usize::from(m.docking.is_some());
+    match (behaviours, m.steps.is_empty()) {
+        (0, true) => {
+            return Err(format!(
+                "{file}: the mission has no [[mission.step]], [mission.ptrans] or [mission.docking]"
+            ));
         }
-        Some(_) if !m.steps.is_empty() => {
-            return Err(format!("{file}: [mission.ptrans] plans its own steps: drop [[mission.step]]"));
+        (1, false) | (2, _) => {
+            return Err(format!(
+                "{file}: [mission.ptrans] and [mission.docking] make their own steps: one of them, and no [[mission.step]]"
+            ));
         }
-        Some(p) => check_ptrans(p).map_err(|e| format!("{file}: mission.ptrans: {e}"))?,
-        None => {}
+        _ => {}
+    }
+    if let Some(p) = &m.ptrans {
+        check_ptrans(p).map_err(|e| format!("{file}: mission.ptrans: {e}"))?;
+    }
+    if let Some(d) = &m.docking {
+        check_docking(d).map_err(|e| format!("{file}: mission.docking: {e}"))?;
     }
     for (i, s) in m.steps.iter().enumerate() {
         match (s.move_m, s.turn_deg, s.refine_pose) {
@@ -169,6 +239,37 @@ fn check_ptrans(p: &PtransGoal) -> Result<(), String> {
     Ok(())
 }
 
+fn check_docking(d: &DockingGoal) -> Result<(), String> {
+    let positive = [
+        d.frame_width_m,
+        d.target_side_m,
+        d.hough_range_m,
+        d.retry_after_m,
+        d.lead_m,
+        d.close_area_px,
+        d.final_m,
+        d.ballistic_mps,
+        d.controlled_mps,
+        d.max_turn_degps,
+        d.turn_gain,
+        d.avoid_sphere_m,
+    ];
+    if !positive.iter().all(|&v| greater(v, 0.0)) {
+        return Err("sizes, ranges, speeds and gains must be positive".into());
+    }
+    let finite = [d.dock_m[0], d.dock_m[1], d.dock_facing_deg, d.frame_height_m, d.target_height_m];
+    if !(finite.iter().all(|v| v.is_finite()) && d.hough_range_sd_m >= 0.0 && d.noise_mps >= 0.0) {
+        return Err("the dock's place and the spreads must be finite".into());
+    }
+    if !(0.0..=1.0).contains(&d.hough_min_certainty) || !greater(d.final_m, d.too_close_m) {
+        return Err("hough_min_certainty must be in 0..1 and too_close_m under final_m".into());
+    }
+    if !(0.0 <= d.target_grey[0] && d.target_grey[0] <= d.target_grey[1] && d.target_grey[1] <= 255.0) {
+        return Err("target_grey must be two grey levels, low then high".into());
+    }
+    Ok(())
+}
+
 /// `v > min`, false for NaN: the check that a number is usable.
 fn greater(v: f64, min: f64) -> bool {
     v > min
@@ -203,7 +304,7 @@ mod tests {
         let ptrans = "[mission]\ndescription = \"d\"\ntimeout_s = 60\n[mission.ptrans]\nto = \"office\"\ngoal_m = [1.0, 2.0]\ngoal_heading_deg = 90\napproach_m = 0.4\ndoor_depth_m = 0.6\nmilestone_m = 0.15\ngoal_tolerance_m = 0.01\nescalate_m = 0.5\nattempts = 3\nback_off_m = 0.3\n";
         assert_eq!(parse(ptrans, "p.toml").expect("parses").ptrans.map(|p| p.goal_m), Some([1.0, 2.0]));
         let both = format!("{ptrans}[[mission.step]]\nmove_m = 1.0\n");
-        assert!(parse(&both, "p.toml").expect_err("steps too").contains("drop [[mission.step]]"));
+        assert!(parse(&both, "p.toml").expect_err("steps too").contains("no [[mission.step]]"));
         let tight = ptrans.replace("escalate_m = 0.5", "escalate_m = 0.1");
         assert!(parse(&tight, "p.toml").expect_err("escalate").contains("mission.ptrans: escalate_m"));
         let on_turn = text.replace("turn_deg = 90", "turn_deg = 90\nincrement_m = 0.5");

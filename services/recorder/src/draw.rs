@@ -36,6 +36,7 @@ draw_with!(
     ServoCorrection => servo,
     harvey_msgs::PoseFix => pose_fix,
     harvey_msgs::PlanSketch => plan,
+    harvey_msgs::BehaviourState => behaviour,
     Detections => detections,
     VisionResult => vision_result,
 );

@@ -38,6 +38,7 @@ pub fn draw_recorded(w: &mut RrdWriter, topic: &str, data: &[u8]) -> Result<bool
         _ if t == topics::EXECUTIVE_SERVO.name => draw::<ServoCorrection>(w, data)?,
         _ if t == topics::EXECUTIVE_POSE.name => draw::<harvey_msgs::PoseFix>(w, data)?,
         _ if t == topics::EXECUTIVE_PLAN.name => draw::<harvey_msgs::PlanSketch>(w, data)?,
+        _ if t == topics::EXECUTIVE_BEHAVIOUR.name => draw::<harvey_msgs::BehaviourState>(w, data)?,
         _ if t == topics::VISION_REQUESTS.name => draw::<VisionRequest>(w, data)?,
         _ if t == topics::VISION_RESULTS.name => draw::<VisionResult>(w, data)?,
         _ if t == topics::CAMERA_FRAME.name => {

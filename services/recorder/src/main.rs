@@ -90,6 +90,7 @@ fn main() -> anyhow::Result<()> {
         tap(&bus, &mut rec, topics::EXECUTIVE_SERVO)?,
         tap(&bus, &mut rec, topics::EXECUTIVE_POSE)?,
         tap(&bus, &mut rec, topics::EXECUTIVE_PLAN)?,
+        tap(&bus, &mut rec, topics::EXECUTIVE_BEHAVIOUR)?,
         tap(&bus, &mut rec, topics::VISION_REQUESTS)?,
         tap(&bus, &mut rec, topics::VISION_RESULTS)?,
         Box::new(FrameTap { sub: bus.frame_subscriber(topics::CAMERA_FRAME)?, channel: frame_channel }),

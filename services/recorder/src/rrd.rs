@@ -48,6 +48,8 @@ pub struct RrdWriter {
     windows: std::collections::BTreeMap<u32, u64>,
     /// Milestone checks already logged.
     plan_checks: u32,
+    /// Acceptor transitions already logged.
+    fsa_transitions: u32,
 }
 
 /// A window not renewed for this long (message time) is taken off the image.
@@ -84,6 +86,7 @@ impl RrdWriter {
             camera,
             windows: Default::default(),
             plan_checks: 0,
+            fsa_transitions: 0,
         };
         if let Some(world) = world {
             w.draw_world(world)?;

@@ -10,6 +10,7 @@ use harvey_msgs::{
 use harvey_vision::cues::{ActivityDetector, ActivityVote, brightest};
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::frs::{ClassRange, Frs};
+use harvey_vision::hough::{DockModel, Hypothesis, find_dock, post_heights};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect, VisionError};
@@ -29,6 +30,8 @@ pub struct Dispatcher {
     frs: Frs,
     /// Activity detection keeps frames: one detector per (standing) request.
     activity: std::collections::BTreeMap<u32, ActivityDetector>,
+    dock_model: DockModel,
+    hypotheses: Vec<Hypothesis>,
     seq: u64,
 }
 
@@ -62,6 +65,8 @@ impl Dispatcher {
             flf: Flf::default(),
             frs: Frs::default(),
             activity: std::collections::BTreeMap::new(),
+            dock_model: DockModel::frame_with_post(),
+            hypotheses: Vec::new(),
             seq: 0,
         }
     }
@@ -169,6 +174,28 @@ impl Dispatcher {
                     .map_err(|e| status_of(&e))?;
                 if let Some(r) = found {
                     push([r.centroid[0], r.centroid[1], r.area as f32, r.mean, 0.0, 0.0]);
+                }
+            }
+            VisionAlgorithm::Dock => {
+                let (lo, hi, n) = (req.params[0], req.params[1], param(req, 2, 5.0));
+                let (rotation, min_certainty) = (req.params[3], param(req, 4, 0.5));
+                let sane = lo.is_finite() && lo >= 2.0 && hi >= lo && hi < 1000.0 && rotation.is_finite();
+                if !sane || !(1.0..=16.0).contains(&n) || !(0.0..=1.0).contains(&min_certainty) {
+                    return Err(VisionStatus::BadParameter);
+                }
+                let n = n as usize;
+                self.hypotheses.clear();
+                self.hypotheses.extend((0..n).map(|k| Hypothesis {
+                    scale: if n == 1 { lo } else { lo + (hi - lo) * k as f32 / (n - 1) as f32 },
+                    rotation,
+                }));
+                let p = FlfParams { min_length: 6.0, ..FlfParams::default() };
+                let lines = self.flf.lines(&img, window, &p).map_err(|e| status_of(&e))?;
+                let found = find_dock(lines, &self.dock_model, &self.hypotheses, [w, ht], 4.0);
+                if let Some(m) = found.filter(|m| m.certainty >= min_certainty) {
+                    let scale = self.hypotheses[m.hypothesis].scale;
+                    let [left, right] = post_heights(lines, m.at, scale);
+                    push([m.at[0], m.at[1], m.certainty, scale, left, right]);
                 }
             }
             VisionAlgorithm::Activity => {

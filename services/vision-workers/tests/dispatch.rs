@@ -197,3 +197,42 @@ fn phototropic_and_activity_requests() {
     assert_eq!(status(&r), VisionStatus::Found, "{r:?}");
     assert!(r.items[0].values[2] > 0.0);
 }
+
+#[test]
+fn the_dock_is_recognised_on_the_bus_with_its_posts_heights() {
+    let w = harvey_world::load_str(include_str!("../../../worlds/dock.toml"), "dock").expect("loads");
+    let mut r = Renderer::new(&w, 640, 480, Encoding::Mono8);
+    let mut px = vec![0u8; r.frame_bytes()];
+    // 3.6 m from the dock's face, 0.4 m to its right, turned 8 degrees towards it.
+    let pose = [10.0, -0.4, 8f64.to_radians()];
+    r.render(&w, pose, &mut px).expect("renders");
+    let h = FrameHeader::new(1, 100_000_000, 640, 480, Encoding::Mono8);
+    let mut d = Dispatcher::new(w.clone());
+    let f = w.camera.focal_for(640);
+    // Scale hypotheses for 2.6-4.6 m: 0.5 m (a model unit) at those depths.
+    let mut dock = request(11, VisionAlgorithm::Dock);
+    dock.params[..5].copy_from_slice(&[(f * 0.5 / 4.6) as f32, (f * 0.5 / 2.6) as f32, 5.0, 0.0, 0.6]);
+    let found = d.answer(&h, &px, &dock);
+    assert_eq!(status(&found), VisionStatus::Found, "{found:?}");
+    let [u, v, certainty, scale, left, right] = found.items[0].values;
+    let centre = w.camera.project(640, 480, pose, [13.6, 0.0, 0.45]).expect("in front");
+    assert!((u as f64 - centre[0]).abs() < 3.0 && (v as f64 - centre[1]).abs() < 3.0, "{found:?} {centre:?}");
+    assert!(certainty >= 0.6 && (60.0..100.0).contains(&scale), "{found:?}");
+    // Seen from the right, the left post is further and looks shorter; each within a pixel or
+    // two of its projection.
+    let height = |y: f64| {
+        let top = w.camera.project(640, 480, pose, [13.6, y, 0.70]).expect("top");
+        let foot = w.camera.project(640, 480, pose, [13.6, y, 0.20]).expect("foot");
+        foot[1] - top[1]
+    };
+    assert!(left < right, "{found:?}");
+    assert!(
+        (f64::from(left) - height(0.5)).abs() < 2.5 && (f64::from(right) - height(-0.5)).abs() < 2.5,
+        "{found:?}"
+    );
+    // Looking away from the dock: not found.
+    r.render(&w, [10.0, -0.4, 1.5], &mut px).expect("renders");
+    assert_eq!(status(&d.answer(&h, &px, &dock)), VisionStatus::NotFound);
+    dock.params[0] = f32::NAN;
+    assert_eq!(status(&d.answer(&h, &px, &dock)), VisionStatus::BadParameter);
+}

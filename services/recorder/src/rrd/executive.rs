@@ -2,9 +2,10 @@
 //! error, turn, estimated offset from the line) and a log line; each pose refinement as the
 //! expected and refined poses in the world view and a log line; the plan sketch as a path
 //! through its milestones (solid where primitive, faint where still abstract), with each
-//! milestone check in the log.
+//! milestone check in the log; a sequenced behaviour's acceptor state as a plot (and each
+//! transition in the log) and its motor schemas' vectors as arrows from the robot.
 
-use harvey_msgs::{CheckOutcome, PlanSketch, PoseFix, ServoCorrection};
+use harvey_msgs::{BehaviourState, CheckOutcome, PlanSketch, PoseFix, ServoCorrection};
 
 use super::RrdWriter;
 use crate::RecordError;
@@ -98,5 +99,38 @@ impl RrdWriter {
             p.checks, p.last_off_m, p.replans
         );
         self.rec.log("log", &rerun::TextLog::new(text).with_level(level)).map_err(|e| self.err(e))
+    }
+
+    pub fn behaviour(&mut self, b: &BehaviourState) -> Result<(), RecordError> {
+        self.at(b.header.stamp_ns);
+        self.rec
+            .log("plots/fsa_state", &rerun::Scalars::single(f64::from(b.fsa_state)))
+            .map_err(|e| self.err(e))?;
+        // move-to-goal, avoid-static-obstacle, noise, avoid-past, probe, sum; 1 m per 0.1 m/s.
+        let colours =
+            [(40, 200, 80), (230, 60, 50), (160, 160, 160), (200, 120, 220), (80, 170, 230), (255, 255, 255)];
+        let origin = super::up([b.at.x_m, b.at.y_m]);
+        let (mut vectors, mut origins, mut cols) = (Vec::new(), Vec::new(), Vec::new());
+        for (k, (r, g, bl)) in colours.into_iter().enumerate() {
+            let v = [b.vectors_mps[2 * k] * 10.0, b.vectors_mps[2 * k + 1] * 10.0];
+            if v[0].hypot(v[1]) > 1e-3 {
+                vectors.push(super::up(v));
+                origins.push(origin);
+                cols.push(rerun::Color::from_rgb(r, g, bl));
+            }
+        }
+        let arrows = rerun::Arrows2D::from_vectors(vectors).with_origins(origins).with_colors(cols);
+        self.rec.log("world/schemas", &arrows).map_err(|e| self.err(e))?;
+        if b.transitions == self.fsa_transitions {
+            return Ok(());
+        }
+        self.fsa_transitions = b.transitions;
+        let trigger = ["normal", "terminal", "recoverable error", "fatal error"]
+            .get(b.last_trigger as usize)
+            .unwrap_or(&"?");
+        let text = format!("acceptor: {trigger} -> q{} (transition {})", b.fsa_state, b.transitions);
+        self.rec
+            .log("log", &rerun::TextLog::new(text).with_level(rerun::TextLogLevel::INFO))
+            .map_err(|e| self.err(e))
     }
 }

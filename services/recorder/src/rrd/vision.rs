@@ -48,6 +48,16 @@ impl RrdWriter {
             Some(VisionAlgorithm::Activity) => {
                 self.rec.log(path.as_str(), &points(&|v| format!("activity {:.1}", v[2])))
             }
+            Some(VisionAlgorithm::Dock) => {
+                // The recognised frame: 2 x 1 model units round its centre, `scale` px a unit.
+                let boxes: Vec<[f32; 2]> = items.iter().map(|i| [i.values[3], i.values[3] / 2.0]).collect();
+                let centres: Vec<[f32; 2]> = items.iter().map(|i| [i.values[0], i.values[1]]).collect();
+                let labels: Vec<String> = items.iter().map(|i| format!("dock {:.2}", i.values[2])).collect();
+                let frame = rerun::Boxes2D::from_centers_and_half_sizes(centres, boxes)
+                    .with_labels(labels)
+                    .with_colors([colour]);
+                self.rec.log(path.as_str(), &frame)
+            }
             Some(VisionAlgorithm::Correlate) => {
                 self.rec.log(path.as_str(), &points(&|v| format!("NC {:.3}", v[2])))
             }
