@@ -47,12 +47,18 @@ pub enum VisionAlgorithm {
     /// left, right]`: the model's reference point (the frame's centre), the winning scale, and
     /// the apparent heights of its end posts (pixels, 0 where not seen; `hough::post_heights`).
     Dock = 7,
+    /// Coded pole recognition (004 §5.1.1): the bright rings of the world's `[poles]` (grey
+    /// levels from `params[0]`, default 200; at least `params[1]` pixels, default 3), grouped
+    /// by column into poles of three rings. The top and bottom rings' spacing gives the range,
+    /// the middle ring's height between them the code. Items, nearest first: `[u, range_m, code,
+    /// v_top, v_bottom, 0]`. A world without `[poles]` is a bad parameter.
+    Poles = 8,
 }
 
 impl VisionAlgorithm {
     pub fn from_raw(raw: u32) -> Option<Self> {
         use VisionAlgorithm::*;
-        [Correlate, Moravec, LineFinder, RegionSegmenter, Phototropic, Activity, Dock]
+        [Correlate, Moravec, LineFinder, RegionSegmenter, Phototropic, Activity, Dock, Poles]
             .into_iter()
             .find(|a| *a as u32 == raw)
     }

@@ -6,6 +6,7 @@ mod camera;
 mod load;
 mod model;
 mod movers;
+mod poles;
 mod raycast;
 pub mod topology;
 
@@ -13,6 +14,7 @@ pub use camera::project_with;
 pub use load::{WorldError, load_str};
 pub use model::*;
 pub use movers::{Mover, load_movers, parse_movers};
+pub use poles::{Pole, PoleField};
 pub use raycast::Hit;
 pub use topology::{Door, Landmark, LandmarkClass, Locale, Meadow, Strategy};
 

@@ -162,6 +162,9 @@ pub struct World {
     pub meadows: Vec<Meadow>,
     #[serde(default, rename = "landmark")]
     pub landmarks: Vec<Landmark>,
+    /// Coded poles to put down at seeded places (`poles.rs`, 004 §5).
+    #[serde(default)]
+    pub poles: Option<crate::PoleField>,
     /// Moving things (`movers.rs`), added from a mission; their walls follow `static_walls`.
     #[serde(skip)]
     pub(crate) movers: Vec<crate::Mover>,

@@ -42,7 +42,7 @@ struct Args {
     rate_hz: f64,
     #[arg(long, default_value_t = 0)]
     frames: u64,
-    /// Seed of the sensor noise (the world's camera sets how much).
+    /// Seed of the sensor noise (the world's camera sets how much) and of the poles' places.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// A launch file whose `[[mover]]` tables put moving things in the world.
@@ -122,6 +122,7 @@ fn main() -> anyhow::Result<()> {
     }
     let world_path = args.world.as_ref().context("--world or --images is required")?;
     let mut world = World::load(world_path)?;
+    world.place_poles(args.seed).map_err(anyhow::Error::msg)?;
     if let Some(file) = &args.movers {
         world.add_movers(harvey_world::load_movers(file)?);
     }

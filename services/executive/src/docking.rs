@@ -8,7 +8,7 @@
 //! hold the heading until the sonar says the dock is at the final distance; q4 docked.
 
 use harvey_msgs::{
-    BehaviourState, Header, MotionCommand, Pose2, SonarRing, VisionAlgorithm, VisionRequest, VisionResult,
+    BehaviourState, MotionCommand, Pose2, SonarRing, VisionAlgorithm, VisionRequest, VisionResult,
     VisionStatus,
 };
 
@@ -16,30 +16,25 @@ use crate::drive::{self, DriveParams, Vectors};
 use crate::fsa::{Fsa, Trigger};
 use crate::mission::DockingGoal;
 use crate::schemas::{Noise, V2, move_to_goal};
+use crate::sequenced::Sequenced;
 
 /// The docking behaviour's state.
 #[derive(Debug, Clone)]
 pub struct Docking {
     g: DockingGoal,
-    pub fsa: Fsa,
+    pub seq: Sequenced,
     drive: DriveParams,
     noise: Noise,
     focal_px: f64,
     centre_px: [f64; 2],
     sensor_ring_m: f64,
     ring: Option<SonarRing>,
-    /// The request awaited, and the next id.
-    pending: Option<u32>,
-    next_request: u32,
     /// World-frame direction of the lamp, last seen.
     light_rad: Option<f64>,
     /// The target's image centre and area (pixels), last tracked or predicted.
     target: Option<[f64; 3]>,
     /// Where the last Hough was tried.
     hough_at: Option<[f64; 2]>,
-    last_trigger: Trigger,
-    next_id: u32,
-    seq: u64,
     /// Whether it docked, once the acceptor has accepted.
     pub done: Option<bool>,
     /// Odometry now, and `(odometry then, pose then)` of the last fix from the dock.
@@ -98,21 +93,16 @@ impl Docking {
         let noise = Noise::new(seed, g.noise_mps, g.noise_ticks);
         Self {
             g,
-            fsa,
+            seq: Sequenced::new(fsa),
             drive,
             noise,
             focal_px: camera.0,
             centre_px: [camera.1 / 2.0, camera.2 / 2.0],
             sensor_ring_m,
             ring: None,
-            pending: None,
-            next_request: 1000,
             light_rad: None,
             target: None,
             hough_at: None,
-            last_trigger: Trigger::Normal,
-            next_id: 1,
-            seq: 0,
             done: None,
             odometry: Pose2::default(),
             fix: None,
@@ -133,19 +123,13 @@ impl Docking {
     }
 
     fn perception(&self) -> &str {
-        self.fsa.state().perception.as_deref().unwrap_or("")
+        self.seq.perception()
     }
 
     fn trigger(&mut self, t: Trigger) {
-        let from = self.fsa.state().name.clone();
-        if let Ok(to) = self.fsa.step(t) {
-            if to.name != from {
-                tracing::info!(from = %from, to = %to.name, trigger = ?t, "acceptor transition");
-            }
-            self.last_trigger = t;
-        }
-        if self.fsa.accepted() {
-            self.done = Some(self.fsa.state().name == self.g.docked_state);
+        self.seq.trigger(t);
+        if self.seq.fsa.accepted() {
+            self.done = Some(self.seq.fsa.state().name == self.g.docked_state);
         }
     }
 
@@ -163,32 +147,11 @@ impl Docking {
         self.ring = Some(*r);
     }
 
-    fn request(
-        &mut self,
-        stamp_ns: u64,
-        algorithm: VisionAlgorithm,
-        window: [f32; 4],
-        params: [f32; 8],
-    ) -> VisionRequest {
-        let id = self.next_request;
-        self.next_request += 1;
-        self.pending = Some(id);
-        VisionRequest {
-            header: Header::new(u64::from(id), stamp_ns),
-            request_id: id,
-            algorithm: algorithm as u32,
-            window_px: window,
-            params,
-            ..VisionRequest::default()
-        }
-    }
-
     /// The answer to the request awaited: the perceptual trigger of the state it was asked in.
     pub fn on_vision(&mut self, r: &VisionResult) {
-        if self.pending != Some(r.request_id) {
+        if !self.seq.answers(r) {
             return;
         }
-        self.pending = None;
         let at = self.believed();
         let found = VisionStatus::from_raw(r.status) == Some(VisionStatus::Found) && r.count > 0;
         let item = found.then(|| r.items[0].values.map(f64::from));
@@ -291,10 +254,11 @@ impl Docking {
                     .is_none_or(|p| (p[0] - at.x_m).hypot(p[1] - at.y_m) >= self.g.retry_after_m);
                 if d <= self.g.hough_range_m && moved {
                     self.trigger(Trigger::Terminal);
-                    self.pending = None;
+                    self.seq.forget();
                 } else {
-                    if self.pending.is_none() {
-                        request = Some(self.request(now, VisionAlgorithm::Phototropic, [0.0; 4], [0.0; 8]));
+                    if !self.seq.waiting() {
+                        request =
+                            Some(self.seq.request(now, VisionAlgorithm::Phototropic, [0.0; 4], [0.0; 8]));
                     }
                     let goal = match self.light_rad {
                         Some(a) => here.plus(V2::new(a.cos(), a.sin()).scale(5.0)),
@@ -307,7 +271,7 @@ impl Docking {
                     parts[2] = self.noise.vector();
                 }
             }
-            "hough-dock" if self.pending.is_none() => {
+            "hough-dock" if !self.seq.waiting() => {
                 // Five scale hypotheses over the distances the belief allows (004 §4.2.2).
                 let unit = self.focal_px * self.g.frame_width_m / 2.0;
                 let near = (d - self.g.hough_range_sd_m).max(0.5);
@@ -321,7 +285,7 @@ impl Docking {
                     0.0,
                     0.0,
                 ];
-                request = Some(self.request(now, VisionAlgorithm::Dock, [0.0; 4], params));
+                request = Some(self.seq.request(now, VisionAlgorithm::Dock, [0.0; 4], params));
                 self.hough_at = Some([at.x_m, at.y_m]);
             }
             "region-tracking" => {
@@ -349,7 +313,7 @@ impl Docking {
                     let speed = self.g.controlled_mps.min(0.5 * (range - self.g.final_m)).max(0.0);
                     parts[0] = V2::new(dir.cos(), dir.sin()).scale(speed);
                     let frame_in_view = d > self.g.fix_beyond_m;
-                    if self.pending.is_none() && frame_in_view && self.since_fix >= self.g.fix_every_ticks {
+                    if !self.seq.waiting() && frame_in_view && self.since_fix >= self.g.fix_every_ticks {
                         // Now and then a fix from the frame, while it is in view.
                         self.since_fix = 0;
                         let unit = self.focal_px * self.g.frame_width_m / 2.0;
@@ -365,8 +329,8 @@ impl Docking {
                             0.0,
                             0.0,
                         ];
-                        request = Some(self.request(now, VisionAlgorithm::Dock, [0.0; 4], params));
-                    } else if self.pending.is_none() {
+                        request = Some(self.seq.request(now, VisionAlgorithm::Dock, [0.0; 4], params));
+                    } else if !self.seq.waiting() {
                         let half = (2.0 * side).max(24.0);
                         let window = [u - half, v - half, u + half, v + half].map(|x| x as f32);
                         let c = [self.centre_px[0] * 2.0, self.centre_px[1] * 2.0];
@@ -377,7 +341,7 @@ impl Docking {
                             window[3].min(c[1] as f32),
                         ];
                         let g = self.g.target_grey.map(|x| x as f32);
-                        request = Some(self.request(
+                        request = Some(self.seq.request(
                             now,
                             VisionAlgorithm::RegionSegmenter,
                             window,
@@ -405,21 +369,9 @@ impl Docking {
         } else {
             drive::velocity(vectors.sum, at, &self.drive)
         };
-        let id = self.next_id;
-        self.next_id += 1;
-        self.seq += 1;
-        let state = BehaviourState {
-            header: Header::new(self.seq, now),
-            at,
-            fsa_state: self.fsa.trace.last().copied().unwrap_or(0) as u32,
-            transitions: self.fsa.trace.len().saturating_sub(1) as u32,
-            last_trigger: self.last_trigger as u32,
-            achieved: u32::from(self.done == Some(true)),
-            vectors_mps: vectors.flat(),
-            linear_mps: v,
-            angular_radps: w,
-        };
-        (request, drive::command(id, now, (v, w)), state)
+        let achieved = u32::from(self.done == Some(true));
+        let (command, state) = self.seq.output(at, now, &vectors, (v, w), achieved);
+        (request, command, state)
     }
 }
 

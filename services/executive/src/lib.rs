@@ -14,6 +14,7 @@ pub mod pose;
 pub mod recover;
 pub mod refining;
 pub mod schemas;
+pub mod sequenced;
 pub mod servo;
 
 use harvey_msgs::{BehaviourState, PlanSketch, PoseFix, SonarRing};

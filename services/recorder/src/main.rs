@@ -41,6 +41,9 @@ struct Args {
     /// The world file of the run: attached to the MCAP file and drawn in the Rerun file.
     #[arg(long)]
     world: Option<PathBuf>,
+    /// The seed of the run: where the world's `[poles]` stand, to draw them.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
     /// The launch file of the run: attached to the MCAP file for `harvey replay`.
     #[arg(long)]
     launch: Option<PathBuf>,
@@ -60,7 +63,8 @@ fn main() -> anyhow::Result<()> {
             let text =
                 std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
             let name = path.file_name().map_or("world.toml".into(), |n| n.to_string_lossy().into_owned());
-            let world = harvey_world::load_str(&text, &path.display().to_string())?;
+            let mut world = harvey_world::load_str(&text, &path.display().to_string())?;
+            world.place_poles(args.seed).map_err(anyhow::Error::msg)?;
             rec.attach_world(&name, &text)?;
             Some(world)
         }

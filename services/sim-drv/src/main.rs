@@ -48,6 +48,9 @@ fn main() -> anyhow::Result<()> {
     if let Some(start) = args.start {
         world.start = start;
     }
+    for p in world.place_poles(args.seed).map_err(anyhow::Error::msg)? {
+        tracing::info!(code = p.code, x_m = p.at[0], y_m = p.at[1], "pole placed");
+    }
     if let Some(file) = &args.movers {
         world.add_movers(harvey_world::load_movers(file)?);
     }

@@ -32,6 +32,7 @@ pub struct Dispatcher {
     activity: std::collections::BTreeMap<u32, ActivityDetector>,
     dock_model: DockModel,
     hypotheses: Vec<Hypothesis>,
+    poles: Vec<[f32; 6]>,
     seq: u64,
 }
 
@@ -67,6 +68,7 @@ impl Dispatcher {
             activity: std::collections::BTreeMap::new(),
             dock_model: DockModel::frame_with_post(),
             hypotheses: Vec::new(),
+            poles: Vec::new(),
             seq: 0,
         }
     }
@@ -196,6 +198,25 @@ impl Dispatcher {
                     let scale = self.hypotheses[m.hypothesis].scale;
                     let [left, right] = post_heights(lines, m.at, scale);
                     push([m.at[0], m.at[1], m.certainty, scale, left, right]);
+                }
+            }
+            VisionAlgorithm::Poles => {
+                let field = self.world.poles.as_ref().ok_or(VisionStatus::BadParameter)?;
+                let (lo, area) = (param(req, 0, 200.0), param(req, 1, 3.0));
+                if !(1.0..=255.0).contains(&lo) || area < 1.0 {
+                    return Err(VisionStatus::BadParameter);
+                }
+                let ranges = [ClassRange { lo: lo as u8, hi: 255, class: 1 }];
+                let rings =
+                    self.frs.segment(&img, window, &ranges, area as u32).map_err(|e| status_of(&e))?;
+                let focal = self.world.camera.focal_for(w as u32);
+                self.poles.clear();
+                for pole in crate::poles::group(rings, field, focal, w as u32) {
+                    self.poles.push(pole);
+                }
+                self.poles.sort_by(|a, b| a[1].total_cmp(&b[1]));
+                for p in &self.poles {
+                    push(*p);
                 }
             }
             VisionAlgorithm::Activity => {

@@ -6,6 +6,7 @@ use harvey_msgs::{Detections, Feature, FrameHeader, Header, MAX_FEATURES};
 /// Algorithm ids carried in [`Detections::algorithm`].
 pub mod dispatch;
 pub mod landmarks;
+pub mod poles;
 pub mod selection;
 pub mod templates;
 

@@ -236,3 +236,36 @@ fn the_dock_is_recognised_on_the_bus_with_its_posts_heights() {
     dock.params[0] = f32::NAN;
     assert_eq!(status(&d.answer(&h, &px, &dock)), VisionStatus::BadParameter);
 }
+
+#[test]
+fn coded_poles_are_recognised_with_their_range_and_code() {
+    let mut w = harvey_world::load_str(include_str!("../../../worlds/arena.toml"), "arena").expect("loads");
+    let poles = w.place_poles(3).expect("room");
+    let mut d = Dispatcher::new(w.clone());
+    let mut r = Renderer::new(&w, 640, 480, Encoding::Mono8);
+    let mut px = vec![0u8; r.frame_bytes()];
+    let h = FrameHeader::new(1, 100_000_000, 640, 480, Encoding::Mono8);
+    let mut seen = 0;
+    // From the start, looking round in steps of half the field of view: every pole in view and
+    // unhidden within 10 m is found with its code and its range to within 3 %.
+    for k in 0..12 {
+        let pose = [w.start.x_m, w.start.y_m, f64::from(k) * 30f64.to_radians()];
+        r.render(&w, pose, &mut px).expect("renders");
+        let res = d.answer(&h, &px, &request(12, VisionAlgorithm::Poles));
+        for item in &res.items[..res.count as usize] {
+            let [u, range, code, ..] = item.values;
+            let p = poles.iter().find(|p| p.code == code as u32).expect("a real code");
+            let depth = (p.at[0] - pose[0]) * pose[2].cos() + (p.at[1] - pose[1]) * pose[2].sin();
+            assert!(
+                (f64::from(range) / depth - 1.0).abs() < 0.03,
+                "pole {code}: {range} m against {depth} m"
+            );
+            let col = w.camera.project(640, 480, pose, [p.at[0], p.at[1], 1.0]).expect("in front")[0];
+            assert!((f64::from(u) - col).abs() < 3.0, "pole {code} at {u}, projects to {col}");
+            seen += 1;
+        }
+    }
+    assert!(seen >= 8, "{seen} sightings");
+    let hallway = Dispatcher::new(hallway()).answer(&h, &px, &request(12, VisionAlgorithm::Poles));
+    assert_eq!(status(&hallway), VisionStatus::BadParameter, "no [poles] in the hallway");
+}

@@ -58,6 +58,20 @@ impl RrdWriter {
                     .with_colors([colour]);
                 self.rec.log(path.as_str(), &frame)
             }
+            Some(VisionAlgorithm::Poles) => {
+                let strips: Vec<Vec<[f32; 2]>> = items
+                    .iter()
+                    .map(|i| vec![[i.values[0], i.values[3]], [i.values[0], i.values[4]]])
+                    .collect();
+                let labels: Vec<String> = items
+                    .iter()
+                    .map(|i| format!("pole {:.0} at {:.1} m", i.values[2], i.values[1]))
+                    .collect();
+                self.rec.log(
+                    path.as_str(),
+                    &rerun::LineStrips2D::new(strips).with_labels(labels).with_colors([colour]),
+                )
+            }
             Some(VisionAlgorithm::Correlate) => {
                 self.rec.log(path.as_str(), &points(&|v| format!("NC {:.3}", v[2])))
             }

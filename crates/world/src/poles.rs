@@ -1,0 +1,157 @@
+//! Coded poles at seeded random places (004 §5, the AAAI-92 competition): a world's `[poles]`
+//! table says how many, where they may stand and how they are marked; `World::place_poles`
+//! puts them down for a seed, as square pillars with three bright rings of "retro-reflective
+//! tape": the top and bottom rings at fixed heights (their spacing gives the range), the middle
+//! ring's height the pole's code.
+
+use serde::Deserialize;
+
+use crate::{Region, Wall, World};
+
+/// The `[poles]` table.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PoleField {
+    pub count: u32,
+    /// Poles stand inside this rectangle (`[x0, y0], [x1, y1]`), at least `clearance_m` from
+    /// every wall, every other pole and the start.
+    pub area_m: [[f64; 2]; 2],
+    pub clearance_m: f64,
+    pub side_m: f64,
+    pub height_m: f64,
+    pub reflectance: f64,
+    /// The rings: their height (m) and reflectance; the top and bottom rings' centres; the middle
+    /// ring's centre for code `k` is `code_base_m + k * code_step_m`.
+    pub ring_m: f64,
+    pub ring_reflectance: f64,
+    pub top_m: f64,
+    pub bottom_m: f64,
+    pub code_base_m: f64,
+    pub code_step_m: f64,
+}
+
+/// One pole put down: its code and where its centre is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pole {
+    pub code: u32,
+    pub at: [f64; 2],
+}
+
+impl PoleField {
+    /// Where the middle ring of code `k` is centred.
+    pub fn code_height_m(&self, k: u32) -> f64 {
+        self.code_base_m + f64::from(k) * self.code_step_m
+    }
+
+    /// The code whose middle ring is nearest `height_m`, if within half a step.
+    pub fn code_at(&self, height_m: f64) -> Option<u32> {
+        let k = ((height_m - self.code_base_m) / self.code_step_m).round();
+        (k >= 0.0
+            && k < f64::from(self.count)
+            && (height_m - self.code_height_m(k as u32)).abs() < self.code_step_m / 2.0)
+            .then_some(k as u32)
+    }
+}
+
+/// splitmix64: a small seeded generator (the same seed puts the poles in the same places).
+fn next(state: &mut u64) -> f64 {
+    *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+    (z ^ (z >> 31)) as f64 / u64::MAX as f64
+}
+
+/// Distance from `p` to the segment `a`-`b`.
+fn to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+    let t = (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / (dx * dx + dy * dy).max(1e-12)).clamp(0.0, 1.0);
+    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
+}
+
+impl World {
+    /// Puts the `[poles]` down for `seed` (none without the table) and returns them, code order.
+    /// Call before adding movers: the poles are static walls.
+    pub fn place_poles(&mut self, seed: u64) -> Result<Vec<Pole>, String> {
+        let Some(f) = self.poles.clone() else { return Ok(Vec::new()) };
+        let mut state = seed ^ 0x5151_7e1e_c0de_0001;
+        let mut placed: Vec<Pole> = Vec::new();
+        let start = [self.start.x_m, self.start.y_m];
+        for code in 0..f.count {
+            let mut tries = 0;
+            let at = loop {
+                tries += 1;
+                if tries > 10_000 {
+                    return Err(format!(
+                        "no room for pole {code} in {:?} with {} m clearance",
+                        f.area_m, f.clearance_m
+                    ));
+                }
+                let [[x0, y0], [x1, y1]] = f.area_m;
+                let p = [x0 + (x1 - x0) * next(&mut state), y0 + (y1 - y0) * next(&mut state)];
+                let clear = self.walls.iter().all(|w| to_segment(p, w.from, w.to) >= f.clearance_m)
+                    && placed.iter().all(|q| (q.at[0] - p[0]).hypot(q.at[1] - p[1]) >= f.clearance_m)
+                    && (start[0] - p[0]).hypot(start[1] - p[1]) >= f.clearance_m;
+                if clear {
+                    break p;
+                }
+            };
+            placed.push(Pole { code, at });
+        }
+        for p in &placed {
+            let h = f.side_m / 2.0;
+            let corners = [[-h, -h], [h, -h], [h, h], [-h, h]].map(|c| [p.at[0] + c[0], p.at[1] + c[1]]);
+            let ring = |centre: f64| Region {
+                along_m: [0.0, f.side_m],
+                height_m: [centre - f.ring_m / 2.0, centre + f.ring_m / 2.0],
+                reflectance: f.ring_reflectance,
+                colour: [1.0, 1.0, 1.0],
+            };
+            let rings = [f.top_m, f.bottom_m, f.code_height_m(p.code)].map(ring);
+            for k in 0..4 {
+                self.walls.push(Wall {
+                    from: corners[k],
+                    to: corners[(k + 1) % 4],
+                    height_m: f.height_m,
+                    reflectance: f.reflectance,
+                    colour: [1.0, 1.0, 1.0],
+                    regions: rings.to_vec(),
+                });
+            }
+        }
+        Ok(placed)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn poles_go_down_clear_of_walls_and_each_other_the_same_way_for_a_seed() {
+        let text = include_str!("../../../worlds/arena.toml");
+        let place = |seed| {
+            let mut w = crate::load_str(text, "arena.toml").expect("loads");
+            let walls = w.walls.len();
+            let poles = w.place_poles(seed).expect("room");
+            assert_eq!(w.walls.len(), walls + 4 * poles.len());
+            poles
+        };
+        let (a, b, c) = (place(1), place(1), place(2));
+        assert_eq!(a, b);
+        assert_ne!(a, c);
+        assert_eq!(a.len(), 10);
+        let w = crate::load_str(text, "arena.toml").expect("loads");
+        let f = w.poles.clone().expect("a [poles] table");
+        for p in &a {
+            assert!(
+                a.iter()
+                    .filter(|q| q.code != p.code)
+                    .all(|q| (q.at[0] - p.at[0]).hypot(q.at[1] - p.at[1]) >= f.clearance_m)
+            );
+            assert!(w.walls.iter().all(|wall| super::to_segment(p.at, wall.from, wall.to) >= f.clearance_m));
+        }
+        for k in 0..10 {
+            assert_eq!(f.code_at(f.code_height_m(k) + 0.3 * f.code_step_m), Some(k));
+        }
+        assert_eq!(f.code_at(f.code_height_m(9) + f.code_step_m), None);
+    }
+}
