@@ -38,8 +38,10 @@ pub struct RunStats {
     /// Milestone checks by outcome (reached, retried, replanned), and pose fixes.
     pub checks: [u32; 3],
     pub fixes: u32,
-    /// The states a sequenced behaviour's acceptor went through.
+    /// The states a sequenced behaviour's acceptor went through, and what it achieved (poles
+    /// parked by; 1 once docked).
     pub fsa_trace: Vec<u32>,
+    pub achieved: u32,
 }
 
 impl RunStats {
@@ -69,6 +71,7 @@ impl RunStats {
                     if run.fsa_trace.last() != Some(&b.fsa_state) {
                         run.fsa_trace.push(b.fsa_state);
                     }
+                    run.achieved = b.achieved;
                 }
                 "executive/plan" => {
                     let p: PlanSketch = harvey_cdr::decode(&m.data).map_err(bad)?;
@@ -172,8 +175,9 @@ impl RunStats {
             );
         }
         if !self.fsa_trace.is_empty() {
-            let trace: Vec<String> = self.fsa_trace.iter().map(|q| format!("q{q}")).collect();
-            out += &format!("  acceptor trace: {}\n", trace.join(" "));
+            let trace: Vec<String> = self.fsa_trace.iter().take(40).map(|q| format!("q{q}")).collect();
+            let more = if self.fsa_trace.len() > 40 { " ..." } else { "" };
+            out += &format!("  acceptor trace: {}{more}; achieved {}\n", trace.join(" "), self.achieved);
         }
         out += &format!(
             "  data seen by the executive: {} sonar rings, {} detections, {} maps\n",

@@ -1,6 +1,6 @@
 //! Coded poles at seeded random places (004 §5, the AAAI-92 competition): a world's `[poles]`
 //! table says how many, where they may stand and how they are marked; `World::place_poles`
-//! puts them down for a seed, as square pillars with three bright rings of "retro-reflective
+//! puts them down for a seed, as eight-sided pillars with three bright rings of "retro-reflective
 //! tape": the top and bottom rings at fixed heights (their spacing gives the range), the middle
 //! ring's height the pole's code.
 
@@ -98,20 +98,28 @@ impl World {
             };
             placed.push(Pole { code, at });
         }
+        // Eight faces round, `side_m` across the flats: a round pole, to the sonar too (a square
+        // one seen corner-on sends every echo away, 001 §3.4).
+        let across = f.side_m / 2.0 / (std::f64::consts::PI / 8.0).cos();
+        let face = 2.0 * across * (std::f64::consts::PI / 8.0).sin();
         for p in &placed {
-            let h = f.side_m / 2.0;
-            let corners = [[-h, -h], [h, -h], [h, h], [-h, h]].map(|c| [p.at[0] + c[0], p.at[1] + c[1]]);
+            let corners: Vec<[f64; 2]> = (0..8)
+                .map(|k| {
+                    let a = (f64::from(k) + 0.5) * std::f64::consts::FRAC_PI_4;
+                    [p.at[0] + across * a.cos(), p.at[1] + across * a.sin()]
+                })
+                .collect();
             let ring = |centre: f64| Region {
-                along_m: [0.0, f.side_m],
+                along_m: [0.0, face],
                 height_m: [centre - f.ring_m / 2.0, centre + f.ring_m / 2.0],
                 reflectance: f.ring_reflectance,
                 colour: [1.0, 1.0, 1.0],
             };
             let rings = [f.top_m, f.bottom_m, f.code_height_m(p.code)].map(ring);
-            for k in 0..4 {
+            for k in 0..8 {
                 self.walls.push(Wall {
                     from: corners[k],
-                    to: corners[(k + 1) % 4],
+                    to: corners[(k + 1) % 8],
                     height_m: f.height_m,
                     reflectance: f.reflectance,
                     colour: [1.0, 1.0, 1.0],
@@ -132,7 +140,7 @@ mod tests {
             let mut w = crate::load_str(text, "arena.toml").expect("loads");
             let walls = w.walls.len();
             let poles = w.place_poles(seed).expect("room");
-            assert_eq!(w.walls.len(), walls + 4 * poles.len());
+            assert_eq!(w.walls.len(), walls + 8 * poles.len());
             poles
         };
         let (a, b, c) = (place(1), place(1), place(2));

@@ -26,9 +26,11 @@ pub enum Refusal {
     PanicStop { id: u32, until_ns: u64 },
 }
 
-/// The panic-stop's hold on the vehicle (001 §6.2): after an urgent stop, motion commands
-/// stamped within `hold_ns` of it are refused (unless urgent themselves: the panic-avoid's), so that no old or new motion command slips in
-/// while the sonar keeps reporting the obstacle (it re-sends the stop with every ring).
+/// The panic-stop's hold on the vehicle (001 §6.2): after an urgent stop, commands that would
+/// drive it forward, stamped within `hold_ns` of it, are refused (unless urgent themselves: the
+/// panic-avoid's), so that no old or new motion command slips in while the sonar keeps
+/// reporting the obstacle ahead (it re-sends the stop with every ring). Turning on the spot and
+/// backing away are let through: without them a robot stopped before a wall would stay there.
 #[derive(Debug)]
 pub struct PanicLatch {
     hold_ns: u64,
@@ -51,11 +53,21 @@ impl PanicLatch {
         match self.until_ns {
             // The panic-avoid's urgent motion overrides the hold (001 §6.2: the panic motor
             // commands override any others).
-            Some(until_ns) if !stop && cmd.urgent == 0 && cmd.header.stamp_ns <= until_ns => {
+            Some(until_ns) if forward(cmd) && cmd.urgent == 0 && cmd.header.stamp_ns <= until_ns => {
                 Err(Refusal::PanicStop { id: cmd.command_id, until_ns })
             }
             _ => Ok(()),
         }
+    }
+}
+
+/// Whether a command would move the vehicle forward (a stop or a turn on the spot would not).
+fn forward(cmd: &MotionCommand) -> bool {
+    match cmd.kind() {
+        Some(CommandKind::Move) => cmd.distance_m > 0.0,
+        Some(CommandKind::Velocity) => cmd.linear_mps > 0.0,
+        Some(CommandKind::Stop | CommandKind::Turn) => false,
+        None => true,
     }
 }
 
@@ -96,10 +108,14 @@ pub fn to_drv(cmd: &MotionCommand) -> Result<Command, Refusal> {
 }
 
 /// Picks what to send from a batch of commands that arrived together: an urgent stop pre-empts
-/// everything else in the batch; otherwise all, in order.
+/// every command in the batch that would drive the vehicle forward, and goes first (turns on
+/// the spot and backing away follow it, as the panic-stop's hold lets them); otherwise all, in
+/// order.
 pub fn prioritise(batch: &[MotionCommand]) -> Vec<MotionCommand> {
     match batch.iter().find(|c| c.urgent != 0 && c.kind() == Some(CommandKind::Stop)) {
-        Some(stop) => vec![*stop],
+        Some(stop) => std::iter::once(*stop)
+            .chain(batch.iter().filter(|c| c.kind() != Some(CommandKind::Stop) && !forward(c)).copied())
+            .collect(),
         None => batch.to_vec(),
     }
 }
@@ -213,6 +229,8 @@ mod tests {
         let mv = cmd(CommandKind::Move, 1.0, 0.0);
         let stop = MotionCommand { urgent: 1, ..cmd(CommandKind::Stop, 0.0, 0.0) };
         assert_eq!(prioritise(&[mv, stop, mv]), vec![stop]);
+        let turn = cmd(CommandKind::Turn, 0.0, 0.5);
+        assert_eq!(prioritise(&[mv, turn, stop]), vec![stop, turn], "a turn on the spot stays");
         assert_eq!(prioritise(&[mv, mv]).len(), 2);
     }
 
@@ -239,6 +257,14 @@ mod tests {
         let evade = MotionCommand { urgent: 1, ..cmd(CommandKind::Turn, 0.0, 1.57) };
         assert_eq!(latch.admit(&at(evade, 1_310_000_000)), Ok(()), "the panic-avoid's urgent turn passes");
         assert_eq!(latch.admit(&at(mv, 1_400_000_000)), Ok(()), "obstacle gone: motion resumes");
+        // Held again: turning on the spot and backing away pass, driving on does not.
+        latch.admit(&at(panic, 2_000_000_000)).expect("the stop");
+        assert_eq!(latch.admit(&at(cmd(CommandKind::Turn, 0.0, 1.0), 2_050_000_000)), Ok(()));
+        assert_eq!(latch.admit(&at(cmd(CommandKind::Move, -0.3, 0.0), 2_060_000_000)), Ok(()));
+        let back = MotionCommand { linear_mps: -0.1, ..cmd(CommandKind::Velocity, 0.0, 0.0) };
+        assert_eq!(latch.admit(&at(back, 2_070_000_000)), Ok(()));
+        let on = MotionCommand { linear_mps: 0.1, ..back };
+        assert!(latch.admit(&at(on, 2_080_000_000)).is_err());
     }
 
     #[test]

@@ -369,6 +369,7 @@ impl Docking {
         } else {
             drive::velocity(vectors.sum, at, &self.drive)
         };
+        let (v, w) = drive::held(self.ring.as_ref(), (v, w));
         let achieved = u32::from(self.done == Some(true));
         let (command, state) = self.seq.output(at, now, &vectors, (v, w), achieved);
         (request, command, state)

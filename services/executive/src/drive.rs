@@ -80,6 +80,12 @@ pub fn velocity(v: V2, at: Pose2, p: &DriveParams) -> (f64, f64) {
     (speed, (p.turn_gain * e).clamp(-p.max_turn_radps, p.max_turn_radps))
 }
 
+/// While the sonar's panic-stop holds (001 §6.2: something is right ahead), the vehicle takes
+/// no command forward: the speed drops to nothing and only the turn (or backing) is left.
+pub fn held(ring: Option<&SonarRing>, (v, w): (f64, f64)) -> (f64, f64) {
+    if ring.is_some_and(|r| r.panic_stop != 0) { (v.min(0.0), w) } else { (v, w) }
+}
+
 /// A velocity command with id `id`.
 pub fn command(id: u32, stamp_ns: u64, (v, w): (f64, f64)) -> MotionCommand {
     MotionCommand {
@@ -129,5 +135,10 @@ mod tests {
         let all =
             vectors([V2::new(1.0, 0.0), V2::new(0.0, 1.0), V2::default(), V2::default(), V2::default()], &P);
         assert!((all.sum.norm() - 0.3).abs() < 1e-12 && all.flat()[10] > 0.0);
+        ring.panic_stop = 1;
+        assert_eq!(held(Some(&ring), (0.2, 0.4)), (0.0, 0.4));
+        assert_eq!(held(Some(&ring), (-0.1, 0.0)), (-0.1, 0.0));
+        ring.panic_stop = 0;
+        assert_eq!(held(Some(&ring), (0.2, 0.4)), (0.2, 0.4));
     }
 }

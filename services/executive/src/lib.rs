@@ -3,6 +3,7 @@
 //! action-level servoing on a landmark after each (`leg.rs`, 000 §5.5). Plan-and-monitor and FSA
 //! sequencing grow from here.
 
+pub mod behaviour;
 pub mod docking;
 pub mod drive;
 pub mod fsa;
@@ -10,6 +11,7 @@ pub mod leg;
 pub mod mission;
 pub mod monitor;
 pub mod plan;
+pub mod pole_hunt;
 pub mod pose;
 pub mod recover;
 pub mod refining;
@@ -96,8 +98,8 @@ pub struct Executive {
     /// Plan-and-monitor, when the mission is a `ptrans` goal: it appends the steps.
     pub plan: Option<monitor::Monitor>,
     plan_seq: u64,
-    /// An acceptor-sequenced docking behaviour, when the mission is one.
-    pub docking: Option<docking::Docking>,
+    /// An acceptor-sequenced behaviour (docking, the pole hunt), when the mission is one.
+    pub behaviour: Option<behaviour::Behaviour>,
     odometry: Pose2,
     belief: Option<(Pose2, Pose2)>,
     /// Times a reflex interrupted the mission.
@@ -134,17 +136,17 @@ impl Executive {
         self
     }
 
-    /// With the docking behaviour driving the robot.
-    pub fn with_docking(mut self, d: docking::Docking) -> Self {
-        self.docking = Some(d);
+    /// With an acceptor-sequenced behaviour driving the robot.
+    pub fn with_behaviour(mut self, b: behaviour::Behaviour) -> Self {
+        self.behaviour = Some(b);
         self
     }
 
     /// A sonar ring (the behaviours' obstacles and ranges).
     pub fn on_sonar(&mut self, r: &SonarRing) {
         self.sonar_rings_seen += 1;
-        if let Some(d) = self.docking.as_mut() {
-            d.on_sonar(r);
+        if let Some(b) = self.behaviour.as_mut() {
+            b.on_sonar(r);
         }
     }
 
@@ -170,7 +172,7 @@ impl Executive {
             fixes: 0,
             plan: None,
             plan_seq: 0,
-            docking: None,
+            behaviour: None,
             odometry: Pose2::default(),
             belief: None,
             preemptions: 0,
@@ -316,8 +318,8 @@ impl Executive {
 
     /// A vision result: the answer to the leg's look, if it is the one awaited.
     pub fn on_vision(&mut self, r: &VisionResult) -> Vec<Output> {
-        if let Some(d) = self.docking.as_mut() {
-            d.on_vision(r);
+        if let Some(b) = self.behaviour.as_mut() {
+            b.on_vision(r);
             return Vec::new();
         }
         if matches!(self.phase, Phase::Refining { .. }) {
@@ -358,26 +360,25 @@ impl Executive {
         self.estimated = self.believed();
         let at = self.estimated;
         let mut out = Vec::new();
-        if let Some(d) = self.docking.as_mut() {
+        if let Some(b) = self.behaviour.as_mut() {
             if matches!(self.phase, Phase::Waiting) {
                 self.start_ns = now;
-                self.goal = d.goal_pose();
                 self.phase = Phase::Executing { step: 0, id: 0 };
             }
             if !matches!(self.phase, Phase::Done(_)) {
-                let (look, command, state) = d.on_odometry(at, now);
-                self.estimated = d.believed();
+                let (look, command, state) = b.on_odometry(at, now);
+                (self.estimated, self.goal) = (b.believed(at), b.goal_pose());
                 out.extend(look.map(Output::Look));
                 out.push(Output::Command(command));
                 out.push(Output::Behaviour(state));
-                if let Some(docked) = d.done {
+                if let Some(well) = b.done() {
                     self.phase =
-                        Phase::Done(if docked { MissionState::Succeeded } else { MissionState::Failed });
+                        Phase::Done(if well { MissionState::Succeeded } else { MissionState::Failed });
                 }
             }
         }
         match self.phase {
-            _ if self.docking.is_some() => {}
+            _ if self.behaviour.is_some() => {}
             Phase::Waiting => {
                 self.start_ns = now;
                 match &self.plan {
@@ -437,7 +438,8 @@ impl Executive {
         }
         let running = !matches!(self.phase, Phase::Done(_));
         if running && now.saturating_sub(self.start_ns) as f64 > self.mission.timeout_s * 1e9 {
-            self.phase = Phase::Done(MissionState::Failed);
+            let enough = self.behaviour.as_ref().is_some_and(|b| b.enough_at_timeout());
+            self.phase = Phase::Done(if enough { MissionState::Succeeded } else { MissionState::Failed });
             out.push(Output::Command(MotionCommand {
                 header: Header::new(u64::from(self.next_id), now),
                 kind: CommandKind::Stop as u32,
@@ -497,6 +499,7 @@ mod tests {
             refine: None,
             ptrans: None,
             docking: None,
+            poles: None,
             steps: vec![
                 Step { move_m: Some(2.0), ..Step::default() },
                 Step { turn_deg: Some(90.0), ..Step::default() },

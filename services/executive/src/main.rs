@@ -7,11 +7,13 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
+use harvey_executive::behaviour::Behaviour;
 use harvey_executive::docking::Docking;
 use harvey_executive::fsa::Fsa;
 use harvey_executive::leg::ServoSetup;
 use harvey_executive::mission::Mission;
 use harvey_executive::monitor::Monitor;
+use harvey_executive::pole_hunt::PoleHunt;
 use harvey_executive::pose::{PinholeCamera, RefineParams};
 use harvey_executive::refining::RefineSetup;
 use harvey_executive::servo::ServoParams;
@@ -106,22 +108,37 @@ fn refine_setup(m: &Mission, world: Option<&World>) -> anyhow::Result<Option<Ref
     }))
 }
 
-/// The docking behaviour: its acceptor (a file next to the launch file), the camera, the sonar.
-fn docking_setup(m: &Mission, world: Option<&World>, args: &Args) -> anyhow::Result<Option<Docking>> {
-    let Some(g) = &m.docking else { return Ok(None) };
-    let w = world.context("[mission.docking] needs --world")?;
-    let path = args.mission.parent().unwrap_or(std::path::Path::new(".")).join(&g.fsa);
+/// An acceptor (a file next to the launch file) that has state `done`.
+fn acceptor(args: &Args, file: &str, done: &str) -> anyhow::Result<Fsa> {
+    let path = args.mission.parent().unwrap_or(std::path::Path::new(".")).join(file);
     let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
     let fsa = Fsa::parse(&text, &path.display().to_string()).map_err(anyhow::Error::msg)?;
-    anyhow::ensure!(
-        fsa.states.iter().any(|s| s.name == g.docked_state),
-        "{}: no state {} (mission.docking.docked_state)",
-        path.display(),
-        g.docked_state
-    );
+    anyhow::ensure!(fsa.states.iter().any(|s| s.name == done), "{}: no state {done}", path.display());
+    Ok(fsa)
+}
+
+/// The docking behaviour or the pole hunt: the acceptor, the camera, the sonar, the seed.
+fn behaviour_setup(m: &Mission, world: Option<&World>, args: &Args) -> anyhow::Result<Option<Behaviour>> {
+    if m.docking.is_none() && m.poles.is_none() {
+        return Ok(None);
+    }
+    let w = world.context("[mission.docking] and [mission.poles] need --world")?;
     let c = &w.camera;
-    let camera = (c.focal_for(c.width_px), f64::from(c.width_px), f64::from(c.height_px));
-    Ok(Some(Docking::new(g.clone(), fsa, camera, w.robot.sonar_ring_radius_m, args.seed)))
+    let (focal, width, height) = (c.focal_for(c.width_px), f64::from(c.width_px), f64::from(c.height_px));
+    let ring = w.robot.sonar_ring_radius_m;
+    if let Some(g) = &m.docking {
+        let fsa = acceptor(args, &g.fsa, &g.docked_state)?;
+        let d = Docking::new(g.clone(), fsa, (focal, width, height), ring, args.seed);
+        return Ok(Some(Behaviour::Docking(Box::new(d))));
+    }
+    let Some(g) = &m.poles else { return Ok(None) };
+    let fsa = acceptor(args, &g.fsa, &g.parked_state)?;
+    let poles =
+        w.poles.as_ref().with_context(|| format!("[mission.poles]: world {} has no [poles]", w.name))?;
+    let s = w.start;
+    let start = harvey_msgs::Pose2 { x_m: s.x_m, y_m: s.y_m, heading_rad: s.heading_deg.to_radians() };
+    let hunt = PoleHunt::new(g.clone(), fsa, (focal, width), ring, poles.side_m, args.seed, start);
+    Ok(Some(Behaviour::Poles(Box::new(hunt))))
 }
 
 fn main() -> anyhow::Result<()> {
@@ -146,7 +163,7 @@ fn main() -> anyhow::Result<()> {
         }
         None => None,
     };
-    let docking = docking_setup(&mission, world.as_ref(), &args)?;
+    let behaviour = behaviour_setup(&mission, world.as_ref(), &args)?;
     tracing::info!(description = %mission.description, steps = mission.steps.len(), "mission loaded");
 
     let bus = Bus::join("executive")?;
@@ -174,8 +191,8 @@ fn main() -> anyhow::Result<()> {
     if let Some(goal) = exec_goal {
         exec = exec.with_plan(goal);
     }
-    if let Some(d) = docking {
-        exec = exec.with_docking(d);
+    if let Some(b) = behaviour {
+        exec = exec.with_behaviour(b);
     }
     let (mut odos, mut seen, mut rings) = (Vec::new(), Vec::new(), Vec::new());
     let mut out = Vec::new();

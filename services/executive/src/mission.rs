@@ -144,6 +144,52 @@ pub struct DockingGoal {
     pub noise_ticks: u32,
 }
 
+/// The pole hunt of the AAAI-92 competition (`[mission.poles]`, 004 §5): visit every coded
+/// pole of the arena, each by the move-to-pole acceptor.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolesGoal {
+    /// The acceptor's file, relative to the launch file, and its state that means parked.
+    pub fsa: String,
+    pub parked_state: String,
+    /// Poles there are; the mission counts as done with `enough` of them visited at its end.
+    pub count: u32,
+    pub enough: u32,
+    /// q0: each look turns the robot this far (half the field of view, 004 §5.3), a pole
+    /// within `centred_deg` of the image centre is centred; after a whole turn with nothing
+    /// new, wander for `wander_s` to look from elsewhere.
+    pub sweep_deg: f64,
+    pub centred_deg: f64,
+    pub wander_s: f64,
+    /// q2: ballistic motion ends this near the pole (believed), or when the timer runs out:
+    /// `timer_slack_s` beyond the time the distance takes at the top speed.
+    pub near_m: f64,
+    pub timer_slack_s: f64,
+    /// q1: how long the robot waits for the IR beacon to come round.
+    pub beacon_wait_s: f64,
+    /// After parking, back away for this long (at the controlled speed) before looking again.
+    pub back_off_s: f64,
+    /// q3: parked when the nearest echo towards the pole is this far from the robot's centre;
+    /// no echo within `lost_m` in that direction and the pole is lost.
+    pub park_m: f64,
+    pub lost_m: f64,
+    /// Speeds (m/s), turn rate (degrees/s) and its gain (per second).
+    pub ballistic_mps: f64,
+    pub controlled_mps: f64,
+    pub max_turn_degps: f64,
+    pub turn_gain: f64,
+    /// The schemas of q2 (004 §5.3): avoid-static-obstacle's sphere (m) and gain, probe's and
+    /// avoid-past's gains (m/s), avoid-past's cell (m) and per-tick decay, noise (m/s, ticks).
+    pub avoid_sphere_m: f64,
+    pub avoid_gain: f64,
+    pub probe_gain: f64,
+    pub past_gain: f64,
+    pub past_cell_m: f64,
+    pub past_decay: f64,
+    pub noise_mps: f64,
+    pub noise_ticks: u32,
+}
+
 /// The `[mission]` table of a launch file.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -157,6 +203,7 @@ pub struct Mission {
     pub refine: Option<Refine>,
     pub ptrans: Option<PtransGoal>,
     pub docking: Option<DockingGoal>,
+    pub poles: Option<PolesGoal>,
 }
 
 #[derive(Deserialize)]
@@ -174,19 +221,24 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
     if !greater(m.timeout_s, 0.0) {
         return Err(format!("{file}: mission.timeout_s must be positive"));
     }
-    let behaviours = usize::from(m.ptrans.is_some()) + usize::from(m.docking.is_some());
+    let behaviours =
+        usize::from(m.ptrans.is_some()) + usize::from(m.docking.is_some()) + usize::from(m.poles.is_some());
     match (behaviours, m.steps.is_empty()) {
         (0, true) => {
             return Err(format!(
-                "{file}: the mission has no [[mission.step]], [mission.ptrans] or [mission.docking]"
+                "{file}: the mission has no [[mission.step]], [mission.ptrans], [mission.docking] or [mission.poles]"
             ));
         }
-        (1, false) | (2, _) => {
+        (1, true) | (0, false) => {}
+        _ => {
             return Err(format!(
-                "{file}: [mission.ptrans] and [mission.docking] make their own steps: one of them, and no [[mission.step]]"
+                "{file}: [mission.ptrans], [mission.docking] and [mission.poles] make their own steps: one of \
+                 them, and no [[mission.step]]"
             ));
         }
-        _ => {}
+    }
+    if let Some(p) = &m.poles {
+        check_poles(p).map_err(|e| format!("{file}: mission.poles: {e}"))?;
     }
     if let Some(p) = &m.ptrans {
         check_ptrans(p).map_err(|e| format!("{file}: mission.ptrans: {e}"))?;
@@ -266,6 +318,30 @@ fn check_docking(d: &DockingGoal) -> Result<(), String> {
     }
     if !(0.0 <= d.target_grey[0] && d.target_grey[0] <= d.target_grey[1] && d.target_grey[1] <= 255.0) {
         return Err("target_grey must be two grey levels, low then high".into());
+    }
+    Ok(())
+}
+
+fn check_poles(p: &PolesGoal) -> Result<(), String> {
+    let positive = [
+        p.sweep_deg,
+        p.centred_deg,
+        p.wander_s,
+        p.near_m,
+        p.park_m,
+        p.lost_m,
+        p.ballistic_mps,
+        p.controlled_mps,
+        p.max_turn_degps,
+        p.turn_gain,
+        p.avoid_sphere_m,
+        p.past_cell_m,
+    ];
+    if !positive.iter().all(|&v| greater(v, 0.0)) || !(0.0..=1.0).contains(&p.past_decay) {
+        return Err("angles, times, distances, speeds and gains must be positive, past_decay in 0..1".into());
+    }
+    if p.count == 0 || p.enough > p.count || !greater(p.lost_m, p.park_m) || !greater(p.near_m, p.park_m) {
+        return Err("count at least 1, enough at most count, lost_m and near_m beyond park_m".into());
     }
     Ok(())
 }
