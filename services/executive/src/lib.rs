@@ -112,6 +112,8 @@ pub struct Executive {
     estimated: Pose2,
     next_id: u32,
     seq: u64,
+    /// Whether the UMS's last map said lost.
+    lost: bool,
     pub sonar_rings_seen: u64,
     pub detections_seen: u64,
     pub maps_seen: u64,
@@ -140,6 +142,16 @@ impl Executive {
     pub fn with_behaviour(mut self, b: behaviour::Behaviour) -> Self {
         self.behaviour = Some(b);
         self
+    }
+
+    /// An uncertainty map from the UMS: plan-and-monitor relocates when it comes to say lost.
+    pub fn on_map(&mut self, m: &harvey_msgs::UncertaintyMap) {
+        self.maps_seen += 1;
+        let became_lost = m.lost != 0 && !self.lost;
+        self.lost = m.lost != 0;
+        if let Some(plan) = self.plan.as_mut().filter(|_| became_lost) {
+            plan.lost();
+        }
     }
 
     /// A sonar ring (the behaviours' obstacles and ranges).
@@ -183,6 +195,7 @@ impl Executive {
             estimated: Pose2::default(),
             next_id: 1,
             seq: 0,
+            lost: false,
             sonar_rings_seen: 0,
             detections_seen: 0,
             maps_seen: 0,

@@ -104,6 +104,7 @@ fn refine_setup(m: &Mission, world: Option<&World>) -> anyhow::Result<Option<Ref
         },
         template_px: r.template_px,
         min_score: r.min_score,
+        max_sd_m: r.max_sd_m.unwrap_or(f64::INFINITY),
         world: Some(w.clone()),
     }))
 }
@@ -194,7 +195,7 @@ fn main() -> anyhow::Result<()> {
     if let Some(b) = behaviour {
         exec = exec.with_behaviour(b);
     }
-    let (mut odos, mut seen, mut rings) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut odos, mut seen, mut rings, mut map_batch) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut out = Vec::new();
     while exec.state() == MissionState::Running {
         if pace.next(&waiter, None)? == Step::Stop {
@@ -206,7 +207,10 @@ fn main() -> anyhow::Result<()> {
             exec.on_sonar(r);
         }
         exec.detections_seen += detections.drain(|_| {})? as u64;
-        exec.maps_seen += maps.drain(|_| {})? as u64;
+        maps.drain_into(&mut map_batch)?;
+        for m in &map_batch {
+            exec.on_map(m);
+        }
         results.drain_into(&mut seen)?;
         odometry.drain_into(&mut odos)?;
         out.clear();

@@ -39,6 +39,10 @@ pub struct Refine {
     pub prior_sd: [f64; 3],
     /// A vertex further than this (pixels) from where the refined pose puts it is dropped.
     pub gate_px: f64,
+    /// A fix that places the robot no better than this (m, `Refined::position_sd_m`) is not
+    /// taken: its vertices leave sideways and turned too hard to tell apart.
+    #[serde(default)]
+    pub max_sd_m: Option<f64>,
 }
 
 /// Action-level servoing settings (`[mission.servo]`).

@@ -76,6 +76,10 @@ pub struct Monitor {
     attempts: u32,
     pub replans: u32,
     pub checks: Vec<Check>,
+    /// The UMS reported the robot lost: relocate (a pose fix) and develop the plan afresh at
+    /// the next step boundary; how often that happened.
+    relocate: bool,
+    pub relocations: u32,
 }
 
 fn turn(rad: f64) -> Step {
@@ -106,6 +110,8 @@ impl Monitor {
             attempts: 0,
             replans: 0,
             checks: Vec::new(),
+            relocate: false,
+            relocations: 0,
         }
     }
 
@@ -142,9 +148,24 @@ impl Monitor {
         refine_leading(&self.world, &mut self.sketch, self.goal.door_depth_m)
     }
 
+    /// The UMS says the robot is lost (002 §3.1: its map grew too large, or predicted
+    /// landmarks went missing): goal-level servoing relocates and re-develops the plan.
+    pub fn lost(&mut self) {
+        if !matches!(self.stage, Stage::Settle | Stage::Finish) && !self.relocate {
+            tracing::warn!("the UMS reports the robot lost: relocating");
+            self.relocate = true;
+        }
+    }
+
     /// What to do once the steps given last are done, from the believed pose `at`; `fixes` counts
     /// the pose fixes so far.
     pub fn next(&mut self, at: Pose2, fixes: u32) -> Result<Next, PlanError> {
+        if std::mem::take(&mut self.relocate) {
+            self.relocations += 1;
+            self.sketch.clear();
+            self.stage = Stage::Develop;
+            return Ok(Next::Steps(vec![fix()]));
+        }
         loop {
             let Some(sub) = self.sketch.first().cloned() else {
                 match self.stage {
@@ -405,6 +426,22 @@ mod tests {
         assert!((miss.off_m - 1.2).abs() < 1e-6, "{miss:?}");
         assert_eq!(m.replans, 1);
         assert!((end.x_m - 12.0).hypot(end.y_m - 2.5) <= 0.0127, "{end:?}");
+    }
+
+    #[test]
+    fn when_the_ums_reports_lost_it_relocates_and_develops_the_plan_afresh() {
+        let mut m = Monitor::new(goal(), hallway());
+        let Ok(Next::Steps(first)) = m.next(BENCH, 0) else { panic!("steps") };
+        assert!(first.iter().any(|s| s.turn_deg.is_some()));
+        m.lost();
+        m.lost();
+        // At the next step boundary: a pose fix, then a plan developed from where that says.
+        assert_eq!(m.next(BENCH, 0), Ok(Next::Steps(vec![fix()])));
+        assert_eq!((m.relocations, m.replans, m.sketch.len()), (1, 0, 0));
+        let fixed = Pose2 { x_m: 4.45, y_m: 3.0, heading_rad: -std::f64::consts::FRAC_PI_2 };
+        let Ok(Next::Steps(_)) = m.next(fixed, 1) else { panic!("steps") };
+        assert_eq!(m.sketch[0].from.at, [4.45, 3.0]);
+        assert_eq!(m.sketch[0].to.name, "robot-lab-side-of-door-0");
     }
 
     #[test]

@@ -54,6 +54,10 @@ pub struct Refined {
     pub rms_px: f64,
     /// Indices of the matches kept.
     pub kept: Vec<usize>,
+    /// How well the matches and the prior fix the position: the root of the position
+    /// covariance's trace (m), for image rows good to `image_sd_px`. Vertices all at one depth
+    /// leave sideways and turned hard to tell apart, and this large.
+    pub position_sd_m: f64,
 }
 
 /// Gauss-Newton on `(x, y, heading)`; `None` with fewer than two matches left.
@@ -68,7 +72,7 @@ pub fn refine(
         if kept.len() < 2 {
             return None;
         }
-        let pose = solve(cam, expected, matches, &kept, p)?;
+        let (pose, information) = solve(cam, expected, matches, &kept, p)?;
         let residual = |i: usize| {
             cam.project(pose, matches[i].world_m).map_or(f64::INFINITY, |q| {
                 (q[0] - matches[i].image_px[0]).hypot(q[1] - matches[i].image_px[1])
@@ -80,21 +84,29 @@ pub fn refine(
             continue;
         }
         let rms = (kept.iter().map(|&i| residual(i).powi(2)).sum::<f64>() / kept.len() as f64).sqrt();
-        return Some(Refined { pose, rms_px: rms, kept });
+        let variance = |k: usize| {
+            let mut e = [0.0; 3];
+            e[k] = 1.0;
+            solve3(information, e).map_or(f64::INFINITY, |c| c[k])
+        };
+        let position_sd_m = (variance(0) + variance(1)).sqrt();
+        return Some(Refined { pose, rms_px: rms, kept, position_sd_m });
     }
 }
 
-/// The weighted least-squares pose of the matches `kept` with the prior, by Gauss-Newton.
+/// The weighted least-squares pose of the matches `kept` with the prior, by Gauss-Newton, and
+/// the information matrix at it (the inverse of its covariance).
 fn solve(
     cam: &PinholeCamera,
     expected: Pose2,
     m: &[VertexMatch],
     kept: &[usize],
     p: &RefineParams,
-) -> Option<Pose2> {
+) -> Option<(Pose2, [[f64; 3]; 3])> {
     let as_pose = |v: [f64; 3]| Pose2 { x_m: v[0], y_m: v[1], heading_rad: v[2] };
     let prior = [expected.x_m, expected.y_m, expected.heading_rad];
     let mut v = prior;
+    let mut information = [[0.0f64; 3]; 3];
     for _ in 0..20 {
         // Normal equations A d = b from the image rows and the prior.
         let (mut a, mut b) = ([[0.0f64; 3]; 3], [0.0f64; 3]);
@@ -126,6 +138,7 @@ fn solve(
             j[k] = 1.0;
             add(j, prior[k] - v[k], 1.0 / (p.prior_sd[k] * p.prior_sd[k]));
         }
+        information = a;
         let d = solve3(a, b)?;
         for k in 0..3 {
             v[k] += d[k];
@@ -134,7 +147,7 @@ fn solve(
             break;
         }
     }
-    Some(as_pose(v))
+    Some((as_pose(v), information))
 }
 
 /// `A x = b` for a 3x3 system (Cramer's rule); `None` when singular.
@@ -207,5 +220,34 @@ mod tests {
         }
         // Nothing to go on: no answer.
         assert!(refine(&cam(), truth, &matches[..1], &params).is_none());
+    }
+
+    #[test]
+    fn vertices_all_at_one_depth_fix_the_position_loosely() {
+        let params = RefineParams { prior_sd: [0.3, 0.3, 0.1], image_sd_px: 0.5, gate_px: 3.0 };
+        let at = Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: 0.0 };
+        let exact = |w: &[[f64; 3]]| -> Vec<VertexMatch> {
+            w.iter()
+                .map(|&w| VertexMatch { world_m: w, image_px: cam().project(at, w).expect("in front") })
+                .collect()
+        };
+        // The end wall's six, 4.5 m off; then three of them with three nearer ones on a side wall.
+        let wall = [
+            [4.5, 0.2, 2.3],
+            [4.5, -0.2, 2.3],
+            [4.5, 0.2, 2.1],
+            [4.5, -0.2, 2.1],
+            [4.5, 1.0, 0.1],
+            [4.5, -1.0, 0.1],
+        ];
+        let mixed = [wall[0], wall[1], wall[4], [2.0, -1.0, 1.5], [2.5, -1.0, 0.9], [3.0, -1.0, 1.5]];
+        let flat = refine(&cam(), at, &exact(&wall), &params).expect("refines");
+        let deep = refine(&cam(), at, &exact(&mixed), &params).expect("refines");
+        assert!(
+            flat.position_sd_m > 0.04 && deep.position_sd_m < 0.02,
+            "{} against {}",
+            flat.position_sd_m,
+            deep.position_sd_m
+        );
     }
 }

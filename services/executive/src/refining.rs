@@ -21,6 +21,8 @@ pub struct RefineSetup {
     pub params: RefineParams,
     pub template_px: u32,
     pub min_score: f64,
+    /// Fixes placing the robot no better than this are refused (`mission.refine.max_sd_m`).
+    pub max_sd_m: f64,
     /// The world, to ask only for vertices in view and not hidden behind a wall; without it,
     /// every vertex is asked for.
     pub world: Option<harvey_world::World>,
@@ -168,6 +170,11 @@ impl Executive {
                 kept = done.kept.len(),
                 "too few vertices agree to fix the pose"
             ),
+            Some(done) if done.position_sd_m > setup.max_sd_m => tracing::warn!(
+                position_sd_m = done.position_sd_m,
+                vertices = done.kept.len(),
+                "the vertices in view fix the pose too loosely"
+            ),
             Some(done) => {
                 tracing::info!(
                     expected_x = expected.x_m,
@@ -178,6 +185,7 @@ impl Executive {
                     vertices = done.kept.len(),
                     of = matches.len(),
                     rms_px = done.rms_px,
+                    position_sd_m = done.position_sd_m,
                     "pose refined"
                 );
                 self.belief = Some((self.odometry, done.pose));
