@@ -224,6 +224,16 @@ impl Docking {
         }
     }
 
+    /// A constrained Hough request for the dock believed `d` from its face: five scale
+    /// hypotheses over the distances the belief allows (004 §4.2.2).
+    fn hough_request(&mut self, now: u64, d: f64) -> VisionRequest {
+        let unit = self.focal_px * self.g.frame_width_m / 2.0;
+        let (far, near) = (d + self.g.hough_range_sd_m, (d - self.g.hough_range_sd_m).max(0.5));
+        let min = self.g.hough_min_certainty as f32;
+        let params = [(unit / far) as f32, (unit / near) as f32, 5.0, 0.0, min, 0.0, 0.0, 0.0];
+        self.seq.request(now, VisionAlgorithm::Dock, [0.0; 4], params)
+    }
+
     /// The nearest sonar range ahead (within 15 degrees), from the robot's centre.
     fn range_ahead(&self) -> Option<f64> {
         let r = self.ring.as_ref()?;
@@ -272,20 +282,7 @@ impl Docking {
                 }
             }
             "hough-dock" if !self.seq.waiting() => {
-                // Five scale hypotheses over the distances the belief allows (004 §4.2.2).
-                let unit = self.focal_px * self.g.frame_width_m / 2.0;
-                let near = (d - self.g.hough_range_sd_m).max(0.5);
-                let params = [
-                    (unit / (d + self.g.hough_range_sd_m)) as f32,
-                    (unit / near) as f32,
-                    5.0,
-                    0.0,
-                    self.g.hough_min_certainty as f32,
-                    0.0,
-                    0.0,
-                    0.0,
-                ];
-                request = Some(self.seq.request(now, VisionAlgorithm::Dock, [0.0; 4], params));
+                request = Some(self.hough_request(now, d));
                 self.hough_at = Some([at.x_m, at.y_m]);
             }
             "region-tracking" => {
@@ -316,20 +313,7 @@ impl Docking {
                     if !self.seq.waiting() && frame_in_view && self.since_fix >= self.g.fix_every_ticks {
                         // Now and then a fix from the frame, while it is in view.
                         self.since_fix = 0;
-                        let unit = self.focal_px * self.g.frame_width_m / 2.0;
-                        let lo = unit / (d + self.g.hough_range_sd_m);
-                        let hi = unit / (d - self.g.hough_range_sd_m).max(0.5);
-                        let params = [
-                            lo as f32,
-                            hi as f32,
-                            5.0,
-                            0.0,
-                            self.g.hough_min_certainty as f32,
-                            0.0,
-                            0.0,
-                            0.0,
-                        ];
-                        request = Some(self.seq.request(now, VisionAlgorithm::Dock, [0.0; 4], params));
+                        request = Some(self.hough_request(now, d));
                     } else if !self.seq.waiting() {
                         let half = (2.0 * side).max(24.0);
                         let window = [u - half, v - half, u + half, v + half].map(|x| x as f32);

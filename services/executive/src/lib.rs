@@ -7,6 +7,7 @@ pub mod behaviour;
 pub mod docking;
 pub mod drive;
 pub mod fsa;
+pub mod goals;
 pub mod leg;
 pub mod mission;
 pub mod monitor;

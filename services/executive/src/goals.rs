@@ -1,0 +1,208 @@
+//! The goal tables of the missions that make their own steps: `[mission.ptrans]` for
+//! plan-and-monitor (000 §2), `[mission.docking]` and `[mission.poles]` for the behaviours that
+//! finite state acceptors sequence (004 §4.2, §5), each with its checks.
+
+use serde::Deserialize;
+
+use crate::mission::greater;
+
+/// A goal for plan-and-monitor (`[mission.ptrans]`, 000 §2, §4): get to a place in locale `to`
+/// from wherever the robot starts, checking a milestone after each subgoal.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PtransGoal {
+    /// The goal locale (a locale of the world), and the place in it (m) with the heading to take.
+    pub to: String,
+    pub goal_m: [f64; 2],
+    pub goal_heading_deg: f64,
+    /// The last subgoal comes in along the goal heading from this far back, so the robot arrives
+    /// facing the right way and never turns far on the spot at the goal (turns skitter, 002 §3.2).
+    pub approach_m: f64,
+    /// How far either side of a doorway its milestones are.
+    pub door_depth_m: f64,
+    /// A milestone is reached when the robot is believed this close to it; the goal, `goal_m`.
+    pub milestone_m: f64,
+    pub goal_tolerance_m: f64,
+    /// A milestone missed by less than this is retried from where the robot is (plan level);
+    /// by more, or `attempts` times, the plan is developed afresh from there (goal level).
+    pub escalate_m: f64,
+    pub attempts: u32,
+    /// A target closer than this is moved to straight, if nearly dead ahead or behind, or else
+    /// approached by backing off first.
+    pub back_off_m: f64,
+}
+
+/// A docking behaviour sequenced by a finite state acceptor (`[mission.docking]`, 004 §4.2).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DockingGoal {
+    /// The acceptor's file, relative to the launch file (`fsa/docking.toml`), and the accepting
+    /// state that means docked (the other accepting states are failures).
+    pub fsa: String,
+    pub docked_state: String,
+    /// The dock face's centre on the floor and the way the face looks (degrees).
+    pub dock_m: [f64; 2],
+    pub dock_facing_deg: f64,
+    /// The Hough model: the frame's width (m; the model is 2 units wide) and its centre's height.
+    pub frame_width_m: f64,
+    pub frame_height_m: f64,
+    /// The tracking target: a square of this side, its centre's height, its grey levels.
+    pub target_side_m: f64,
+    pub target_height_m: f64,
+    pub target_grey: [f64; 2],
+    /// The phototropic cue counts only a region this bright (grey level): with the lamp hidden,
+    /// the brightest thing in view is something else.
+    pub light_min_grey: f64,
+    /// The Hough is tried once the dock is believed this near, give or take (scale hypotheses),
+    /// with matches covering at least this share of the model; after a failure, once the robot
+    /// has moved this far for a new view.
+    pub hough_range_m: f64,
+    pub hough_range_sd_m: f64,
+    pub hough_min_certainty: f64,
+    pub retry_after_m: f64,
+    /// Tracking steers for the dock's axis this far ahead of the robot (the approach zone), and
+    /// hands over to the sonar when the target covers this many pixels.
+    pub lead_m: f64,
+    /// Controlled motion keeps within this of the target's bearing (degrees), so that the
+    /// target stays in the image.
+    pub keep_in_view_deg: f64,
+    pub close_area_px: f64,
+    /// While tracking, every this many ticks a fix from the Hough's frame, while the robot is
+    /// further than `fix_beyond_m` from the face (nearer, the frame leaves the image).
+    pub fix_every_ticks: u32,
+    pub fix_beyond_m: f64,
+    /// After the first, a fix further than these from the belief is taken as a misreading.
+    pub fix_gate_m: f64,
+    pub fix_gate_deg: f64,
+    /// Docked when the robot's centre is this far from the face; closer than `too_close_m` is
+    /// a fatal error.
+    pub final_m: f64,
+    pub too_close_m: f64,
+    /// Ballistic and controlled speeds (m/s), turn rate limit (degrees/s) and gain (per second).
+    pub ballistic_mps: f64,
+    pub controlled_mps: f64,
+    pub max_turn_degps: f64,
+    pub turn_gain: f64,
+    /// avoid-static-obstacle's sphere of influence beyond the robot (m) and gain (m/s); the
+    /// noise schema's size (m/s) and how many ticks each direction is held.
+    pub avoid_sphere_m: f64,
+    pub avoid_gain: f64,
+    pub noise_mps: f64,
+    pub noise_ticks: u32,
+}
+
+/// The pole hunt of the AAAI-92 competition (`[mission.poles]`, 004 §5): visit every coded
+/// pole of the arena, each by the move-to-pole acceptor.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PolesGoal {
+    /// The acceptor's file, relative to the launch file, and its state that means parked.
+    pub fsa: String,
+    pub parked_state: String,
+    /// Poles there are; the mission counts as done with `enough` of them visited at its end.
+    pub count: u32,
+    pub enough: u32,
+    /// q0: each look turns the robot this far (half the field of view, 004 §5.3), a pole
+    /// within `centred_deg` of the image centre is centred; after a whole turn with nothing
+    /// new, wander for `wander_s` to look from elsewhere.
+    pub sweep_deg: f64,
+    pub centred_deg: f64,
+    pub wander_s: f64,
+    /// q2: ballistic motion ends this near the pole (believed), or when the timer runs out:
+    /// `timer_slack_s` beyond the time the distance takes at the top speed.
+    pub near_m: f64,
+    pub timer_slack_s: f64,
+    /// q1: how long the robot waits for the IR beacon to come round.
+    pub beacon_wait_s: f64,
+    /// After parking, back away for this long (at the controlled speed) before looking again.
+    pub back_off_s: f64,
+    /// q3: parked when the nearest echo towards the pole is this far from the robot's centre;
+    /// no echo within `lost_m` in that direction and the pole is lost.
+    pub park_m: f64,
+    pub lost_m: f64,
+    /// Speeds (m/s), turn rate (degrees/s) and its gain (per second).
+    pub ballistic_mps: f64,
+    pub controlled_mps: f64,
+    pub max_turn_degps: f64,
+    pub turn_gain: f64,
+    /// The schemas of q2 (004 §5.3): avoid-static-obstacle's sphere (m) and gain, probe's and
+    /// avoid-past's gains (m/s), avoid-past's cell (m) and per-tick decay, noise (m/s, ticks).
+    pub avoid_sphere_m: f64,
+    pub avoid_gain: f64,
+    pub probe_gain: f64,
+    pub past_gain: f64,
+    pub past_cell_m: f64,
+    pub past_decay: f64,
+    pub noise_mps: f64,
+    pub noise_ticks: u32,
+}
+
+pub(crate) fn check_ptrans(p: &PtransGoal) -> Result<(), String> {
+    let lengths =
+        [p.approach_m, p.door_depth_m, p.milestone_m, p.goal_tolerance_m, p.escalate_m, p.back_off_m];
+    if !lengths.iter().all(|&v| greater(v, 0.0)) || !p.goal_heading_deg.is_finite() {
+        return Err("lengths must be positive and the heading finite".into());
+    }
+    if !p.goal_m.iter().all(|v| v.is_finite()) || p.attempts == 0 {
+        return Err("goal_m must be finite and attempts at least 1".into());
+    }
+    if p.escalate_m <= p.milestone_m.max(p.goal_tolerance_m) {
+        return Err("escalate_m must exceed milestone_m and goal_tolerance_m".into());
+    }
+    Ok(())
+}
+
+pub(crate) fn check_docking(d: &DockingGoal) -> Result<(), String> {
+    let positive = [
+        d.frame_width_m,
+        d.target_side_m,
+        d.hough_range_m,
+        d.retry_after_m,
+        d.lead_m,
+        d.close_area_px,
+        d.final_m,
+        d.ballistic_mps,
+        d.controlled_mps,
+        d.max_turn_degps,
+        d.turn_gain,
+        d.avoid_sphere_m,
+    ];
+    if !positive.iter().all(|&v| greater(v, 0.0)) {
+        return Err("sizes, ranges, speeds and gains must be positive".into());
+    }
+    let finite = [d.dock_m[0], d.dock_m[1], d.dock_facing_deg, d.frame_height_m, d.target_height_m];
+    if !(finite.iter().all(|v| v.is_finite()) && d.hough_range_sd_m >= 0.0 && d.noise_mps >= 0.0) {
+        return Err("the dock's place and the spreads must be finite".into());
+    }
+    if !(0.0..=1.0).contains(&d.hough_min_certainty) || !greater(d.final_m, d.too_close_m) {
+        return Err("hough_min_certainty must be in 0..1 and too_close_m under final_m".into());
+    }
+    if !(0.0 <= d.target_grey[0] && d.target_grey[0] <= d.target_grey[1] && d.target_grey[1] <= 255.0) {
+        return Err("target_grey must be two grey levels, low then high".into());
+    }
+    Ok(())
+}
+
+pub(crate) fn check_poles(p: &PolesGoal) -> Result<(), String> {
+    let positive = [
+        p.sweep_deg,
+        p.centred_deg,
+        p.wander_s,
+        p.near_m,
+        p.park_m,
+        p.lost_m,
+        p.ballistic_mps,
+        p.controlled_mps,
+        p.max_turn_degps,
+        p.turn_gain,
+        p.avoid_sphere_m,
+        p.past_cell_m,
+    ];
+    if !positive.iter().all(|&v| greater(v, 0.0)) || !(0.0..=1.0).contains(&p.past_decay) {
+        return Err("angles, times, distances, speeds and gains must be positive, past_decay in 0..1".into());
+    }
+    if p.count == 0 || p.enough > p.count || !greater(p.lost_m, p.park_m) || !greater(p.near_m, p.park_m) {
+        return Err("count at least 1, enough at most count, lost_m and near_m beyond park_m".into());
+    }
+    Ok(())
+}
