@@ -43,7 +43,6 @@ pub struct Docking {
     /// The believed heading when the target was last seen, and ticks since the last fix asked.
     target_heading: f64,
     since_fix: u32,
-    pub fixes: u32,
 }
 
 /// The robot's pose from the dock recognised in the image (the inverse perspective of 004
@@ -82,14 +81,13 @@ impl Docking {
     /// `camera` = (focal length, image width, height) in pixels; `sensor_ring_m` the sonar ring's
     /// radius; `seed` the noise schema's.
     pub fn new(g: DockingGoal, fsa: Fsa, camera: (f64, f64, f64), sensor_ring_m: f64, seed: u64) -> Self {
-        let drive = DriveParams {
-            max_speed_mps: g.ballistic_mps,
-            max_turn_radps: g.max_turn_degps.to_radians(),
-            turn_gain: g.turn_gain,
-            robot_radius_m: sensor_ring_m,
-            sphere_m: g.avoid_sphere_m,
-            avoid_gain: g.avoid_gain,
-        };
+        let drive = DriveParams::new(
+            g.ballistic_mps,
+            g.max_turn_degps,
+            g.turn_gain,
+            sensor_ring_m,
+            (g.avoid_sphere_m, g.avoid_gain),
+        );
         let noise = Noise::new(seed, g.noise_mps, g.noise_ticks);
         Self {
             g,
@@ -108,7 +106,6 @@ impl Docking {
             fix: None,
             target_heading: 0.0,
             since_fix: 0,
-            fixes: 0,
         }
     }
 
@@ -135,12 +132,7 @@ impl Docking {
 
     /// Odometry, moved by the last fix from the dock.
     pub fn believed(&self) -> Pose2 {
-        match self.fix {
-            Some((then, pose)) => {
-                crate::refining::compose(pose, crate::refining::relative(then, self.odometry))
-            }
-            None => self.odometry,
-        }
+        crate::refining::fixed(self.fix, self.odometry)
     }
 
     pub fn on_sonar(&mut self, r: &SonarRing) {
@@ -173,7 +165,6 @@ impl Docking {
                 "pose from the dock"
             );
             self.fix = Some((self.odometry, p));
-            self.fixes += 1;
         }
         match (self.perception(), item) {
             // A fix asked for while tracking: nothing more to it.
@@ -236,11 +227,9 @@ impl Docking {
 
     /// The nearest sonar range ahead (within 15 degrees), from the robot's centre.
     fn range_ahead(&self) -> Option<f64> {
-        let r = self.ring.as_ref()?;
-        (0..r.range_m.len())
-            .filter(|&i| r.valid_mask & (1 << i) != 0 && f64::from(r.bearing_rad[i]).sin().abs() < 0.27)
-            .filter(|&i| f64::from(r.bearing_rad[i]).cos() > 0.0)
-            .map(|i| f64::from(r.range_m[i]) + self.sensor_ring_m)
+        drive::echoes(self.ring.as_ref()?, 0.0, self.sensor_ring_m)
+            .filter(|(b, _)| b.sin().abs() < 0.27 && b.cos() > 0.0)
+            .map(|(_, r)| r)
             .min_by(f64::total_cmp)
     }
 

@@ -41,27 +41,45 @@ impl Vectors {
     }
 }
 
+impl DriveParams {
+    /// The settings a behaviour's goal table gives (turn rate in degrees per second); the
+    /// robot's radius is the sonar ring's.
+    pub fn new(
+        max_speed_mps: f64,
+        max_turn_degps: f64,
+        turn_gain: f64,
+        robot_radius_m: f64,
+        avoid: (f64, f64),
+    ) -> Self {
+        let (sphere_m, avoid_gain) = avoid;
+        Self {
+            max_speed_mps,
+            max_turn_radps: max_turn_degps.to_radians(),
+            turn_gain,
+            robot_radius_m,
+            sphere_m,
+            avoid_gain,
+        }
+    }
+}
+
+/// The ring's valid echoes as (bearing, range): the bearing from `heading` (0: relative to the
+/// robot), the range from the robot's centre (`sensor_ring_m` out to the sensors).
+pub fn echoes(ring: &SonarRing, heading: f64, sensor_ring_m: f64) -> impl Iterator<Item = (f64, f64)> + '_ {
+    (0..ring.range_m.len())
+        .filter(|&i| ring.valid_mask & (1 << i) != 0 && ring.range_m[i].is_finite())
+        .map(move |i| (heading + f64::from(ring.bearing_rad[i]), sensor_ring_m + f64::from(ring.range_m[i])))
+}
+
 /// avoid-static-obstacle over the ring's echoes: each valid echo is a small obstacle where the
 /// sensor saw it; their pushes add up.
 pub fn avoid_echoes(ring: &SonarRing, at: Pose2, sensor_ring_m: f64, p: &DriveParams) -> V2 {
-    let mut v = V2::default();
-    for i in 0..ring.range_m.len() {
-        if ring.valid_mask & (1 << i) == 0 || !ring.range_m[i].is_finite() {
-            continue;
-        }
-        let b = at.heading_rad + f64::from(ring.bearing_rad[i]);
-        let d = sensor_ring_m + f64::from(ring.range_m[i]);
-        let echo = V2::new(at.x_m + d * b.cos(), at.y_m + d * b.sin());
-        v = v.plus(avoid_obstacle(
-            V2::new(at.x_m, at.y_m),
-            echo,
-            p.robot_radius_m,
-            p.sphere_m,
-            p.avoid_gain,
-            10.0,
-        ));
-    }
-    v
+    let here = V2::new(at.x_m, at.y_m);
+    echoes(ring, at.heading_rad, sensor_ring_m)
+        .map(|(b, d)| here.plus(V2::new(b.cos(), b.sin()).scale(d)))
+        .fold(V2::default(), |v, echo| {
+            v.plus(avoid_obstacle(here, echo, p.robot_radius_m, p.sphere_m, p.avoid_gain, 10.0))
+        })
 }
 
 /// The sum of `parts`, clipped to the top speed.

@@ -49,6 +49,8 @@ pub struct PoleHunt {
     sensor_ring_m: f64,
     pole_half_m: f64,
     ring: Option<SonarRing>,
+    /// The ring's echoes as (world bearing, range), for probe (kept between ticks).
+    echo_buf: Vec<(f64, f64)>,
     at: Pose2,
     look: Look,
     /// Looks in a row without a pole to go to.
@@ -74,14 +76,13 @@ impl PoleHunt {
         seed: u64,
         start: Pose2,
     ) -> Self {
-        let drive = DriveParams {
-            max_speed_mps: g.ballistic_mps,
-            max_turn_radps: g.max_turn_degps.to_radians(),
-            turn_gain: g.turn_gain,
-            robot_radius_m: sensor_ring_m,
-            sphere_m: g.avoid_sphere_m,
-            avoid_gain: g.avoid_gain,
-        };
+        let drive = DriveParams::new(
+            g.ballistic_mps,
+            g.max_turn_degps,
+            g.turn_gain,
+            sensor_ring_m,
+            (g.avoid_sphere_m, g.avoid_gain),
+        );
         let noise = Noise::new(seed, g.noise_mps, g.noise_ticks);
         let past =
             AvoidPast::new(V2::new(start.x_m, start.y_m), 80, g.past_cell_m, g.past_gain, g.past_decay);
@@ -96,6 +97,7 @@ impl PoleHunt {
             sensor_ring_m,
             pole_half_m: pole_side_m / 2.0,
             ring: None,
+            echo_buf: Vec::with_capacity(harvey_msgs::SONAR_SENSORS),
             at: start,
             look: Look::Ask,
             fruitless: 0,
@@ -120,20 +122,6 @@ impl PoleHunt {
 
     pub fn on_sonar(&mut self, r: &SonarRing) {
         self.ring = Some(*r);
-    }
-
-    /// Valid echoes as (world bearing, range from the robot's centre).
-    fn echoes(&self) -> Vec<(f64, f64)> {
-        let Some(r) = &self.ring else { return Vec::new() };
-        (0..r.range_m.len())
-            .filter(|&i| r.valid_mask & (1 << i) != 0 && r.range_m[i].is_finite())
-            .map(|i| {
-                (
-                    self.at.heading_rad + f64::from(r.bearing_rad[i]),
-                    f64::from(r.range_m[i]) + self.sensor_ring_m,
-                )
-            })
-            .collect()
     }
 
     /// A pole-recognition answer: the pole sought (or the nearest not yet visited) centred,
@@ -249,11 +237,11 @@ impl PoleHunt {
             "sonar-parking" => {
                 let towards = goal.minus(here);
                 let bearing = towards.y.atan2(towards.x);
-                let nearest = self
-                    .echoes()
-                    .into_iter()
-                    .filter(|(b, _)| wrap(b - bearing).abs() <= 30f64.to_radians())
-                    .min_by(|a, b| a.1.total_cmp(&b.1));
+                let nearest = self.ring.as_ref().and_then(|r| {
+                    drive::echoes(r, at.heading_rad, self.sensor_ring_m)
+                        .filter(|(b, _)| wrap(b - bearing).abs() <= 30f64.to_radians())
+                        .min_by(|a, b| a.1.total_cmp(&b.1))
+                });
                 match nearest {
                     Some((_, r)) if r <= self.g.park_m => self.park(true),
                     Some((b, r)) if r <= self.g.lost_m => {
@@ -280,13 +268,17 @@ impl PoleHunt {
     /// q2's schemas (or wandering's, without a goal): move-to-goal, avoid-static-obstacle,
     /// noise, avoid-past, probe.
     fn wander(&mut self, at: Pose2, here: V2, goal: Option<V2>) -> [V2; 5] {
-        let echoes = self.echoes();
+        self.echo_buf.clear();
+        if let Some(r) = &self.ring {
+            self.echo_buf.extend(drive::echoes(r, at.heading_rad, self.sensor_ring_m));
+        }
         let avoid = self
             .ring
             .as_ref()
             .map_or(V2::default(), |r| drive::avoid_echoes(r, at, self.sensor_ring_m, &self.drive));
         let to_goal = goal.map_or(V2::default(), |g| move_to_goal(here, g, self.g.ballistic_mps));
-        [to_goal, avoid, self.noise.vector(), self.past.vector(here), probe(&echoes, self.g.probe_gain)]
+        let open = probe(&self.echo_buf, self.g.probe_gain);
+        [to_goal, avoid, self.noise.vector(), self.past.vector(here), open]
     }
 
     /// q3 is over (parked or the pole lost): q4, then the next pole.

@@ -74,6 +74,12 @@ pub fn compose(base: Pose2, rel: Pose2) -> Pose2 {
     }
 }
 
+/// The pose now, from a fix `(odometry then, pose then)` and odometry now: the fixed pose moved
+/// by what odometry says happened since (odometry itself without a fix).
+pub fn fixed(fix: Option<(Pose2, Pose2)>, odometry: Pose2) -> Pose2 {
+    fix.map_or(odometry, |(then, pose)| compose(pose, relative(then, odometry)))
+}
+
 /// `to` in `from`'s frame.
 pub fn relative(from: Pose2, to: Pose2) -> Pose2 {
     let (c, s) = (from.heading_rad.cos(), from.heading_rad.sin());
@@ -84,12 +90,7 @@ pub fn relative(from: Pose2, to: Pose2) -> Pose2 {
 impl Executive {
     /// The pose the executive believes: odometry, moved by the last refinement.
     pub(crate) fn believed(&self) -> Pose2 {
-        match self.belief {
-            Some((odometry_then, believed_then)) => {
-                compose(believed_then, relative(odometry_then, self.odometry))
-            }
-            None => self.odometry,
-        }
+        fixed(self.belief, self.odometry)
     }
 
     /// Starts a `refine_pose` step: every vertex asked for at once, from the believed pose (off
