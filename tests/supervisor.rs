@@ -92,8 +92,12 @@ fn a_killed_service_is_restarted_and_the_others_never_stop() {
         }
         waiter.wait(Some(Duration::from_millis(200))).expect("wait");
     }
-    while pid_of(&prefix, "encoders").is_none() {
-        assert!(Instant::now() < deadline, "encoders, the last service, never joined the bus");
+    // Wait for odometry, not merely for the encoders' node to be listed: iceoryx2 lists a node
+    // before its creation has finished cleaning the domain's dead nodes, so a sonar killed in that
+    // window would be cleaned by the encoders and not by the supervisor under test. Odometry is
+    // published only once the encoders' node exists in full.
+    while odometry.drain(|_| {}).expect("drain") == 0 {
+        assert!(Instant::now() < deadline, "encoders, the last service, never published odometry");
         std::thread::sleep(Duration::from_millis(20));
     }
     let others: Vec<(&str, i32)> = ["sim-drv", "denning-bridge", "encoders"]
