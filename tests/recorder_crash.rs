@@ -17,6 +17,7 @@ fn a_killed_recorder_loses_at_most_a_second_and_recover_salvages_the_rest() {
     let mcap = dir.join("run.mcap");
     let mut recorder = Command::new(common::bin("harvey-recorder"))
         .args(["--output", mcap.to_str().expect("utf8"), "--flush-ms", "500"])
+        .args(["--world", "worlds/arena.toml", "--seed", "5"])
         .env(harvey_bus::PREFIX_ENV, &prefix)
         .stderr(Stdio::null())
         .spawn()
@@ -70,6 +71,13 @@ fn a_killed_recorder_loses_at_most_a_second_and_recover_salvages_the_rest() {
         .filter(|m: &TruePose| m.header.seq > 0)
         .collect();
     assert!(summary.stats.expect("stats").message_count >= msgs.len() as u64);
+    // The world and the seed that places its poles survive, for `harvey export`.
+    let worlds: Vec<&str> = summary.attachment_indexes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(worlds, ["arena.toml"]);
+    let world_md =
+        summary.metadata_indexes.iter().find(|m| m.name == "harvey.world").expect("world metadata");
+    let world_md = mcap::read::metadata(&bytes, world_md).expect("reads");
+    assert_eq!(world_md.metadata.get("seed").map(String::as_str), Some("5"));
     let last = msgs.last().expect("something salvaged").header.seq;
     // A prefix of what was sent, in order, with nothing missing inside it.
     let gaps: Vec<(u64, u64)> = msgs

@@ -9,9 +9,11 @@ use harvey_msgs::{
     ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult, topics,
 };
 
+use harvey_world::World;
+
 use crate::draw::Draw;
 use crate::rrd::RrdWriter;
-use crate::{RecordError, WORLD_MEDIA_TYPE};
+use crate::{RecordError, WORLD_MEDIA_TYPE, WORLD_METADATA};
 
 fn draw<T: Ros2Msg + Draw>(w: &mut RrdWriter, data: &[u8]) -> Result<(), String> {
     let msg: T = decode(data).map_err(|e| e.to_string())?;
@@ -57,13 +59,10 @@ pub fn export(mcap: &Path, rrd: &Path, mut progress: impl FnMut(u64, u64)) -> Re
     let bytes = std::fs::read(mcap).map_err(|e| err(e.to_string()))?;
     let summary = mcap::Summary::read(&bytes).ok().flatten();
     let total = summary.as_ref().and_then(|s| s.stats.as_ref()).map_or(0, |s| s.message_count);
-    let world = summary.as_ref().and_then(|s| {
-        s.attachment_indexes.iter().filter(|a| a.media_type == WORLD_MEDIA_TYPE).find_map(|a| {
-            let att = mcap::read::attachment(&bytes, a).ok()?;
-            let text = String::from_utf8(att.data.to_vec()).ok()?;
-            harvey_world::load_str(&text, &att.name).ok()
-        })
-    });
+    let world = match &summary {
+        Some(s) => recorded_world(&bytes, s).map_err(err)?,
+        None => None,
+    };
     let mut w = RrdWriter::create(rrd, world.as_ref())?;
     let stream = mcap::MessageStream::new(&bytes).map_err(|e| err(format!("not an MCAP file: {e}")))?;
     let mut drawn = 0u64;
@@ -81,4 +80,80 @@ pub fn export(mcap: &Path, rrd: &Path, mut progress: impl FnMut(u64, u64)) -> Re
     progress(total, total);
     w.finish()?;
     Ok(drawn)
+}
+
+/// The world a recording carries, its `[poles]` placed by the recorded seed (1 when the recording
+/// predates the `harvey.world` record, as the recorder's default); `None` without a world
+/// attachment. A world attachment that does not load is an error naming it.
+fn recorded_world(bytes: &[u8], summary: &mcap::Summary) -> Result<Option<World>, String> {
+    let Some(index) = summary.attachment_indexes.iter().find(|a| a.media_type == WORLD_MEDIA_TYPE) else {
+        return Ok(None);
+    };
+    let att = mcap::read::attachment(bytes, index)
+        .map_err(|e| format!("world attachment `{}`: {e}", index.name))?;
+    let text = std::str::from_utf8(&att.data).map_err(|e| format!("world attachment `{}`: {e}", att.name))?;
+    let mut world = harvey_world::load_str(text, &att.name).map_err(|e| format!("world attachment: {e}"))?;
+    let mut seed = 1;
+    if let Some(m) = summary.metadata_indexes.iter().find(|m| m.name == WORLD_METADATA) {
+        let record =
+            mcap::read::metadata(bytes, m).map_err(|e| format!("`{WORLD_METADATA}` metadata: {e}"))?;
+        if let Some(text) = record.metadata.get("seed") {
+            seed = text.parse().map_err(|e| format!("`{WORLD_METADATA}` metadata: seed `{text}`: {e}"))?;
+        }
+    }
+    world.place_poles(seed).map_err(|e| format!("world attachment `{}`: {e}", att.name))?;
+    Ok(Some(world))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Recorder;
+
+    const ARENA: &str = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/../../worlds/arena.toml"));
+
+    fn recording(name: &str, world: &str, seed: u64) -> Vec<u8> {
+        let dir = std::env::temp_dir().join(format!("harvey-export-{}-{name}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("tmp");
+        let path = dir.join("t.mcap");
+        let mut r = Recorder::create(&path).expect("create");
+        r.attach_world("arena.toml", world, seed).expect("attach");
+        r.finish().expect("finish");
+        let bytes = std::fs::read(&path).expect("read");
+        std::fs::remove_dir_all(&dir).ok();
+        bytes
+    }
+
+    fn walls(w: &World) -> Vec<[[f64; 2]; 2]> {
+        w.walls.iter().map(|w| [w.from, w.to]).collect()
+    }
+
+    #[test]
+    fn export_places_the_poles_where_the_recorded_seed_put_them() {
+        for seed in [3, 4] {
+            let bytes = recording(&format!("s{seed}"), ARENA, seed);
+            let summary = mcap::Summary::read(&bytes).expect("summary").expect("present");
+            let got = recorded_world(&bytes, &summary).expect("loads").expect("a world");
+            let mut want = harvey_world::load_str(ARENA, "arena.toml").expect("arena");
+            let bare = want.walls.len();
+            let poles = want.place_poles(seed).expect("placed");
+            assert_eq!(poles.len(), 10);
+            assert!(want.walls.len() > bare, "poles are walls");
+            assert_eq!(walls(&got), walls(&want), "seed {seed}");
+        }
+        let (a, b) = (recording("a", ARENA, 3), recording("b", ARENA, 4));
+        let world = |bytes: &[u8]| {
+            let s = mcap::Summary::read(bytes).expect("summary").expect("present");
+            walls(&recorded_world(bytes, &s).expect("loads").expect("a world"))
+        };
+        assert_ne!(world(&a), world(&b), "another seed, other places");
+    }
+
+    #[test]
+    fn a_world_attachment_that_does_not_load_is_named() {
+        let bytes = recording("bad", "[[wall]]\nfrom = \"here\"\n", 1);
+        let summary = mcap::Summary::read(&bytes).expect("summary").expect("present");
+        let e = recorded_world(&bytes, &summary).expect_err("malformed world");
+        assert!(e.contains("world attachment") && e.contains("arena.toml"), "{e}");
+    }
 }

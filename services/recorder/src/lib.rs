@@ -23,6 +23,8 @@ const QOS_YAML: &str = "- history: 1\n  depth: 16\n  reliability: 1\n  durabilit
 
 /// Media type of the world file attached to a recording.
 pub const WORLD_MEDIA_TYPE: &str = "application/toml; harvey-world";
+/// Name of the metadata record that goes with the world attachment: its file name and the seed.
+pub const WORLD_METADATA: &str = "harvey.world";
 /// Media type of the launch file (services and mission) attached to a recording: what
 /// `harvey replay` runs again.
 pub const LAUNCH_MEDIA_TYPE: &str = "application/toml; harvey-launch";
@@ -148,9 +150,14 @@ impl Recorder {
         self.write(ch, h.seq, h.stamp_ns)
     }
 
-    /// Stores the world file the run used, so that offline tools (`harvey export`) can draw it.
-    pub fn attach_world(&mut self, name: &str, text: &str) -> Result<(), RecordError> {
-        self.attach(name, WORLD_MEDIA_TYPE, text)
+    /// Stores the world file the run used and the run's seed (a `harvey.world` metadata record;
+    /// it places the world's `[poles]`), so that offline tools (`harvey export`) can draw it.
+    pub fn attach_world(&mut self, name: &str, text: &str, seed: u64) -> Result<(), RecordError> {
+        self.attach(name, WORLD_MEDIA_TYPE, text)?;
+        let metadata =
+            BTreeMap::from([("file".to_owned(), name.to_owned()), ("seed".to_owned(), seed.to_string())]);
+        let record = Metadata { name: WORLD_METADATA.into(), metadata };
+        self.writer.write_metadata(&record).map_err(|e| self.err(e))
     }
 
     /// Stores the launch file of the run, so that `harvey replay` can run its services again.

@@ -65,7 +65,7 @@ fn main() -> anyhow::Result<()> {
             let name = path.file_name().map_or("world.toml".into(), |n| n.to_string_lossy().into_owned());
             let mut world = harvey_world::load_str(&text, &path.display().to_string())?;
             world.place_poles(args.seed).map_err(anyhow::Error::msg)?;
-            rec.attach_world(&name, &text)?;
+            rec.attach_world(&name, &text, args.seed)?;
             Some(world)
         }
         None => None,

@@ -32,6 +32,7 @@ pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordError> {
     let options = EnumSet::only(Options::IgnoreEndMagic);
     let mut profile = String::new();
     let mut attachments = Vec::new();
+    let mut metadata = Vec::new();
     let mut stopped_at = None;
     let linear =
         mcap::read::LinearReader::new_with_options(&bytes, options).map_err(|e| err(e.to_string()))?;
@@ -39,6 +40,7 @@ pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordError> {
         match record {
             Ok(Record::Header(h)) => profile = h.profile,
             Ok(Record::Attachment { header, data, .. }) => attachments.push((header, data)),
+            Ok(Record::Metadata(m)) => metadata.push(m),
             Ok(_) => {}
             Err(e) => {
                 stopped_at = Some(e.to_string());
@@ -63,6 +65,9 @@ pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordError> {
             data: Cow::Borrowed(data),
         };
         w.attach(&a).map_err(oerr)?;
+    }
+    for m in &metadata {
+        w.write_metadata(m).map_err(oerr)?;
     }
     let mut messages = 0;
     let stream = mcap::MessageStream::new_with_options(&bytes, options).map_err(|e| err(e.to_string()))?;
