@@ -26,10 +26,10 @@ fn run(mission: &str, tag: &str, steps: &str) -> Run {
         out.stdout,
         out.stderr
     );
-    let bytes = out.mcap;
+    let bytes = out.mcap.as_slice();
     let (mut truth, mut looks, mut corrections, mut levels) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for m in mcap::MessageStream::new(&bytes).expect("mcap") {
+    for m in mcap::MessageStream::new(bytes).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
             "/sim/truth" => {

@@ -34,9 +34,9 @@ fn run(launch: &std::path::Path, tag: &str) -> Run {
     let movers = parse_movers(&text, "panic-avoid").expect("movers");
     let cart = movers.first().expect("a cart");
     let out = common::run_mission(launch.to_str().expect("utf8"), tag);
-    let bytes = out.mcap;
+    let bytes = out.mcap.as_slice();
     let (mut closest_m, mut reflex, mut panic_stops) = (f64::MAX, Vec::new(), 0);
-    for m in mcap::MessageStream::new(&bytes).expect("mcap") {
+    for m in mcap::MessageStream::new(bytes).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
             "/sim/truth" => {

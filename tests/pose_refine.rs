@@ -13,9 +13,9 @@ const INCH: f64 = 0.0254;
 fn expected_poses_inches_off_are_refined_to_within_an_inch_and_a_half() {
     let out = common::run_mission("missions/pose-refine.toml", "prefine");
     assert!(out.status.success() && out.stdout.contains("goal reached (4/4 steps)"), "{}", out.stdout);
-    let bytes = out.mcap;
+    let bytes = out.mcap.as_slice();
     let (mut fixes, mut truth) = (Vec::new(), None);
-    for m in mcap::MessageStream::new(&bytes).expect("mcap") {
+    for m in mcap::MessageStream::new(bytes).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
             "/executive/pose" => fixes.push(harvey_cdr::decode::<PoseFix>(&m.data).expect("fix")),

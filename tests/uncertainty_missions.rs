@@ -15,9 +15,9 @@ fn run(mission: &str, tag: &str) -> Vec<UncertaintyMap> {
         out.stdout,
         out.stderr
     );
-    let bytes = out.mcap;
+    let bytes = out.mcap.as_slice();
     let (mut maps, mut truth) = (Vec::new(), Vec::new());
-    for m in mcap::MessageStream::new(&bytes).expect("mcap") {
+    for m in mcap::MessageStream::new(bytes).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
             "/ums/map" => maps.push(harvey_cdr::decode::<UncertaintyMap>(&m.data).expect("map")),

@@ -105,6 +105,18 @@ pub struct MissionRun {
     pub stderr: String,
     /// The recording's bytes.
     pub mcap: Vec<u8>,
+    /// The run folder: removed when the test passes, kept (and named) when it fails.
+    pub dir: PathBuf,
+}
+
+impl Drop for MissionRun {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("the run is kept in {}", self.dir.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.dir);
+        }
+    }
 }
 
 /// Runs `mission` (a path from the repository root, or absolute); checks nothing of the
@@ -121,6 +133,7 @@ pub fn run_mission(mission: &str, tag: &str) -> MissionRun {
         stdout: String::from_utf8_lossy(&out.stdout).into_owned(),
         stderr: String::from_utf8_lossy(&out.stderr).into_owned(),
         mcap: std::fs::read(dir.join("run.mcap")).unwrap_or_default(),
+        dir,
     }
 }
 
