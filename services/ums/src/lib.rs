@@ -63,6 +63,9 @@ struct Step {
 pub enum Output {
     Map(Box<UncertaintyMap>),
     Expectation(Expectation),
+    /// A sighting that fell due could not be applied (why, naming it); the map and the
+    /// expectations of the same odometry go out all the same.
+    Rejected(String),
 }
 
 /// The UMS's state.
@@ -80,6 +83,8 @@ pub struct Ums {
     last_stamp_ns: u64,
     missed: u32,
     seq: u64,
+    /// Each expectation's own sequence number (several go out per map, or none).
+    expectation_seq: u64,
 }
 
 impl Ums {
@@ -100,6 +105,7 @@ impl Ums {
             last_stamp_ns: 0,
             missed: 0,
             seq: 0,
+            expectation_seq: 0,
         }
     }
 
@@ -151,15 +157,16 @@ impl Ums {
         let due: Vec<LandmarkSighting> =
             self.pending.iter().copied().filter(|s| s.header.stamp_ns <= o.header.stamp_ns).collect();
         self.pending.retain(|s| s.header.stamp_ns > o.header.stamp_ns);
-        let mut rejected = Vec::new();
-        for s in due {
-            if let Err(e) = self.apply_sighting(&s) {
-                rejected.push(e);
-            }
-        }
+        let rejected: Vec<Output> =
+            due.iter().filter_map(|s| self.apply_sighting(s).err()).map(Output::Rejected).collect();
         let mut out = vec![Output::Map(Box::new(self.publishable(o.header.stamp_ns)))];
-        out.extend(self.expectations(o.header.stamp_ns).into_iter().map(Output::Expectation));
-        if rejected.is_empty() { Ok(out) } else { Err(rejected.join("; ")) }
+        for mut e in self.expectations(o.header.stamp_ns) {
+            self.expectation_seq += 1;
+            e.header.seq = self.expectation_seq;
+            out.push(Output::Expectation(e));
+        }
+        out.extend(rejected);
+        Ok(out)
     }
 
     /// A sighting: checked, then applied at its stamp once odometry has reached it.
@@ -266,7 +273,8 @@ impl Ums {
         }
     }
 
-    /// Windows for the landmarks of the meadow under the map's centre that are active from it.
+    /// Windows for the landmarks of the meadow under the map's centre that are active from it
+    /// (sequence number 0: `on_odometry` numbers what it publishes).
     pub fn expectations(&self, stamp_ns: u64) -> Vec<Expectation> {
         let m = &self.map;
         let Some(meadow) = self.world.meadow_at(m.centre[0], m.centre[1]) else { return Vec::new() };
@@ -288,7 +296,7 @@ impl Ums {
                     LandmarkClass::III => 3,
                 };
                 Some(Expectation {
-                    header: Header::new(self.seq, stamp_ns),
+                    header: Header::new(0, stamp_ns),
                     landmark_index: i as u32,
                     class,
                     window_px: [win.u0 as f32, win.v0 as f32, win.u1 as f32, win.v1 as f32],

@@ -91,9 +91,10 @@ fn main() -> anyhow::Result<()> {
                 Ok(out) => {
                     for x in out {
                         match x {
-                            Output::Map(m) => map_pub.send(&m)?,
-                            Output::Expectation(e) => expectations.send(&e)?,
-                        };
+                            Output::Map(m) => _ = map_pub.send(&m)?,
+                            Output::Expectation(e) => _ = expectations.send(&e)?,
+                            Output::Rejected(e) => tracing::warn!("rejected: {e}"),
+                        }
                     }
                 }
                 Err(e) => tracing::warn!("rejected: {e}"),

@@ -159,3 +159,37 @@ fn a_pose_fix_shrinks_the_map_at_its_stamp_and_a_bad_one_is_refused() {
     assert!(u.on_fix(&bad).expect_err("refused").contains("non-finite"));
     assert_eq!(u.map().area_m2(), fixed);
 }
+
+#[test]
+fn a_sighting_rejected_when_it_falls_due_costs_neither_the_map_nor_the_expectations() {
+    let mut u = ums();
+    for k in 1..=5 {
+        u.on_odometry(&odo(k * 50, k as f64 * 0.2)).expect("ok");
+    }
+    // Stamped after the odometry so far, so held until odometry reaches it; then impossible.
+    let impossible = sighting(300, "office-sign", SightingKind::BearingRange, std::f64::consts::PI, 3.0);
+    u.on_sighting(&impossible).expect("held until due");
+    let out = u.on_odometry(&odo(300, 1.2)).expect("the odometry itself is sound");
+    assert_eq!(map_of(&out).header.seq, 6, "the map goes out, next in sequence");
+    assert!(out.iter().any(|o| matches!(o, Output::Expectation(_))));
+    let why: Vec<&str> = out
+        .iter()
+        .filter_map(|o| if let Output::Rejected(e) = o { Some(e.as_str()) } else { None })
+        .collect();
+    assert_eq!(why.len(), 1, "{why:?}");
+    assert!(why[0].contains("sighting of `office-sign`"), "{why:?}");
+}
+
+#[test]
+fn expectations_are_numbered_one_by_one_across_maps() {
+    let mut u = ums();
+    let mut seqs = Vec::new();
+    for k in 1..=20 {
+        let out = u.on_odometry(&odo(k * 50, k as f64 * 0.2)).expect("ok");
+        seqs.extend(
+            out.iter().filter_map(|o| if let Output::Expectation(e) = o { Some(e.header.seq) } else { None }),
+        );
+    }
+    assert!(seqs.len() > 20, "several windows per map: {}", seqs.len());
+    assert_eq!(seqs, (1..=seqs.len() as u64).collect::<Vec<_>>());
+}
