@@ -151,7 +151,11 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             Ok(report_comparison(&c, &recording, &again))
         }
         Cmd::Info { recording } => {
-            print!("{}", summary::RunStats::read(&recording)?.info_table());
+            let stats = summary::RunStats::read(&recording)?;
+            print!("{}", stats.info_table());
+            if stats.last_status.is_some() {
+                print!("{}", stats.mission_summary());
+            }
             Ok(0)
         }
         Cmd::Diff { a, b } => {

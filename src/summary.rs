@@ -7,14 +7,11 @@ use std::path::Path;
 use anyhow::Context;
 use harvey_msgs::{CheckOutcome, MissionState, MissionStatus, PlanSketch, TruePose, UncertaintyMap};
 
-/// One line of the summary: a labelled pose.
+/// One line of the summary: a labelled pose, its heading in (-180, 180] degrees.
 fn pose_line(label: &str, p: &harvey_msgs::Pose2) -> String {
-    format!(
-        "  {label:<11} x {:7.3} m  y {:7.3} m  heading {:7.2} deg\n",
-        p.x_m,
-        p.y_m,
-        p.heading_rad.to_degrees()
-    )
+    let deg = p.heading_rad.to_degrees();
+    let deg = 180.0 - (180.0 - deg).rem_euclid(360.0);
+    format!("  {label:<11} x {:7.3} m  y {:7.3} m  heading {deg:7.2} deg\n", p.x_m, p.y_m)
 }
 
 /// What one topic of a recording holds.
@@ -42,12 +39,16 @@ pub struct RunStats {
     /// parked by; 1 once docked).
     pub fsa_trace: Vec<u32>,
     pub achieved: u32,
+    /// In a world with `[poles]`: when the true path first came by each pole (code order), and
+    /// how close counts.
+    pub pole_visits: Option<(Vec<Option<f64>>, f64)>,
 }
 
 impl RunStats {
     pub fn read(path: &Path) -> anyhow::Result<Self> {
         let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
         let mut run = RunStats::default();
+        let mut true_path: Vec<(f64, [f64; 2])> = Vec::new();
         let stream = mcap::MessageStream::new(&bytes)
             .with_context(|| format!("{}: not an MCAP file", path.display()))?;
         for (i, m) in stream.enumerate() {
@@ -63,7 +64,12 @@ impl RunStats {
             let bad = |e| anyhow::anyhow!("{}: message {i} on /{topic}: {e}", path.display());
             match topic.as_str() {
                 "executive/status" => run.last_status = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
-                "sim/truth" => run.last_truth = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
+                "sim/truth" => {
+                    let t: TruePose = harvey_cdr::decode(&m.data).map_err(bad)?;
+                    let p = t.world_from_robot;
+                    true_path.push((t.header.stamp_ns as f64 / 1e9, [p.x_m, p.y_m]));
+                    run.last_truth = Some(t);
+                }
                 "ums/map" => run.last_map = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
                 "executive/pose" => run.fixes += 1,
                 "executive/behaviour" => {
@@ -90,6 +96,15 @@ impl RunStats {
             }
         }
         if let Ok(Some(summary)) = mcap::Summary::read(&bytes) {
+            match harvey_recorder::export::recorded_world(&bytes, &summary) {
+                Ok(Some((w, poles))) => {
+                    if let Some(f) = w.poles.as_ref() {
+                        run.pole_visits = Some((f.first_visits(&poles, &true_path), f.visit_m));
+                    }
+                }
+                Ok(None) => {}
+                Err(e) => tracing::warn!("{}: {e}; poles not counted", path.display()),
+            }
             for idx in summary.metadata_indexes.iter().filter(|i| i.name == "harvey.recorder") {
                 let md = mcap::read::metadata(&bytes, idx)
                     .with_context(|| format!("{}: recorder metadata", path.display()))?;
@@ -140,21 +155,33 @@ impl RunStats {
             Some(MissionState::Failed) => "FAILED",
             _ => "still running when stopped",
         };
-        out += &format!(
-            "mission: {state} ({}/{} steps) at t = {:.2} s\n",
-            s.step,
-            s.step_count,
-            s.header.stamp_ns as f64 / 1e9
-        );
+        // A behaviour runs no script: no steps to count.
+        let steps =
+            if s.step_count > 0 { format!(" ({}/{} steps)", s.step, s.step_count) } else { String::new() };
+        out += &format!("mission: {state}{steps} at t = {:.2} s\n", s.header.stamp_ns as f64 / 1e9);
+        // A pole hunt's goal is only the pole it went for last: its poles are its figure.
         let g = s.goal;
-        out += &pose_line("goal", &g);
-        let e = s.estimated;
-        out += &pose_line("estimated", &e);
+        if self.pole_visits.is_none() {
+            out += &pose_line("goal", &g);
+        }
+        out += &pose_line("estimated", &s.estimated);
         if let Some(t) = &self.last_truth {
             let p = t.world_from_robot;
-            let err = (p.x_m - g.x_m).hypot(p.y_m - g.y_m);
             out += &pose_line("true", &p);
-            out += &format!("  final error {:.3} m ({:.2} in) from the goal\n", err, err / 0.0254);
+            if self.pole_visits.is_none() {
+                let err = (p.x_m - g.x_m).hypot(p.y_m - g.y_m);
+                out += &format!("  final error {:.3} m ({:.2} in) from the goal\n", err, err / 0.0254);
+            }
+        }
+        if let Some((visits, within_m)) = &self.pole_visits {
+            let times: Vec<f64> = visits.iter().flatten().copied().collect();
+            let last = times.iter().copied().fold(None, |a: Option<f64>, t| Some(a.map_or(t, |a| a.max(t))));
+            out += &format!(
+                "  poles visited {} of {} (true path within {within_m:.2} m of a pole){}\n",
+                times.len(),
+                visits.len(),
+                last.map_or(String::new(), |t| format!(", the last first reached at t = {t:.2} s"))
+            );
         }
         if let Some(m) = &self.last_map {
             let wedge = (m.heading_ccw_rad + m.heading_cw_rad).to_degrees();

@@ -28,6 +28,8 @@ pub struct PoleField {
     pub bottom_m: f64,
     pub code_base_m: f64,
     pub code_step_m: f64,
+    /// A pole counts as visited once the robot's centre comes this close to the pole's centre.
+    pub visit_m: f64,
 }
 
 /// One pole put down: its code and where its centre is.
@@ -50,6 +52,19 @@ impl PoleField {
             && k < f64::from(self.count)
             && (height_m - self.code_height_m(k as u32)).abs() < self.code_step_m / 2.0)
             .then_some(k as u32)
+    }
+
+    /// When `path` (time in s, position) first came within `visit_m` of each of `poles`, in
+    /// their order; `None` for a pole never visited.
+    pub fn first_visits(&self, poles: &[Pole], path: &[(f64, [f64; 2])]) -> Vec<Option<f64>> {
+        poles
+            .iter()
+            .map(|p| {
+                path.iter()
+                    .find(|(_, q)| (q[0] - p.at[0]).hypot(q[1] - p.at[1]) < self.visit_m)
+                    .map(|(t, _)| *t)
+            })
+            .collect()
     }
 }
 
@@ -161,5 +176,20 @@ mod tests {
             assert_eq!(f.code_at(f.code_height_m(k) + 0.3 * f.code_step_m), Some(k));
         }
         assert_eq!(f.code_at(f.code_height_m(9) + f.code_step_m), None);
+    }
+
+    #[test]
+    fn a_pole_is_visited_when_the_path_first_comes_within_visit_m_of_it() {
+        let w = crate::load_str(include_str!("../../../worlds/arena.toml"), "arena.toml").expect("loads");
+        let f = w.poles.clone().expect("a [poles] table");
+        let poles = [super::Pole { code: 0, at: [5.0, 5.0] }, super::Pole { code: 1, at: [9.0, 5.0] }];
+        // Along y = 5 + 0.8 m (inside 0.9 m of both centres' x) from x = 0 to 6, at 1 m/s.
+        let path: Vec<(f64, [f64; 2])> =
+            (0..=60).map(|k| (f64::from(k) / 10.0, [f64::from(k) / 10.0, 5.8])).collect();
+        let visits = f.first_visits(&poles, &path);
+        let first = visits[0].expect("passes the first pole");
+        // (x - 5)^2 + 0.8^2 < 0.9^2 first at x = 4.6 (0.412 m along x).
+        assert!((first - 4.6).abs() < 1e-9, "{first}");
+        assert_eq!(visits[1], None, "never near the second");
     }
 }

@@ -9,7 +9,7 @@ use harvey_msgs::{
     ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap, VisionRequest, VisionResult, topics,
 };
 
-use harvey_world::World;
+use harvey_world::{Pole, World};
 
 use crate::draw::Draw;
 use crate::rrd::RrdWriter;
@@ -59,8 +59,14 @@ pub fn export(mcap: &Path, rrd: &Path, mut progress: impl FnMut(u64, u64)) -> Re
     let bytes = std::fs::read(mcap).map_err(|e| err(e.to_string()))?;
     let summary = mcap::Summary::read(&bytes).ok().flatten();
     let total = summary.as_ref().and_then(|s| s.stats.as_ref()).map_or(0, |s| s.message_count);
-    let world = match &summary {
-        Some(s) => recorded_world(&bytes, s).map_err(err)?,
+    // The messages are the recording; a world that no longer loads (an older file format, say)
+    // only costs the drawing of the walls.
+    let world = match summary.as_ref().map(|s| recorded_world(&bytes, s)) {
+        Some(Ok(world)) => world.map(|(w, _)| w),
+        Some(Err(e)) => {
+            tracing::warn!("{}: {e}; drawing without the world", mcap.display());
+            None
+        }
         None => None,
     };
     let mut w = RrdWriter::create(rrd, world.as_ref())?;
@@ -82,10 +88,10 @@ pub fn export(mcap: &Path, rrd: &Path, mut progress: impl FnMut(u64, u64)) -> Re
     Ok(drawn)
 }
 
-/// The world a recording carries, its `[poles]` placed by the recorded seed (1 when the recording
-/// predates the `harvey.world` record, as the recorder's default); `None` without a world
-/// attachment. A world attachment that does not load is an error naming it.
-fn recorded_world(bytes: &[u8], summary: &mcap::Summary) -> Result<Option<World>, String> {
+/// The world a recording carries, with its `[poles]` placed by the recorded seed (1 when the
+/// recording predates the `harvey.world` record, as the recorder's default), and those poles;
+/// `None` without a world attachment. A world attachment that does not load is an error naming it.
+pub fn recorded_world(bytes: &[u8], summary: &mcap::Summary) -> Result<Option<(World, Vec<Pole>)>, String> {
     let Some(index) = summary.attachment_indexes.iter().find(|a| a.media_type == WORLD_MEDIA_TYPE) else {
         return Ok(None);
     };
@@ -101,8 +107,8 @@ fn recorded_world(bytes: &[u8], summary: &mcap::Summary) -> Result<Option<World>
             seed = text.parse().map_err(|e| format!("`{WORLD_METADATA}` metadata: seed `{text}`: {e}"))?;
         }
     }
-    world.place_poles(seed).map_err(|e| format!("world attachment `{}`: {e}", att.name))?;
-    Ok(Some(world))
+    let poles = world.place_poles(seed).map_err(|e| format!("world attachment `{}`: {e}", att.name))?;
+    Ok(Some((world, poles)))
 }
 
 #[cfg(test)]
@@ -133,18 +139,18 @@ mod tests {
         for seed in [3, 4] {
             let bytes = recording(&format!("s{seed}"), ARENA, seed);
             let summary = mcap::Summary::read(&bytes).expect("summary").expect("present");
-            let got = recorded_world(&bytes, &summary).expect("loads").expect("a world");
+            let (got, placed) = recorded_world(&bytes, &summary).expect("loads").expect("a world");
             let mut want = harvey_world::load_str(ARENA, "arena.toml").expect("arena");
             let bare = want.walls.len();
             let poles = want.place_poles(seed).expect("placed");
-            assert_eq!(poles.len(), 10);
+            assert_eq!((poles.len(), &placed), (10, &poles));
             assert!(want.walls.len() > bare, "poles are walls");
             assert_eq!(walls(&got), walls(&want), "seed {seed}");
         }
         let (a, b) = (recording("a", ARENA, 3), recording("b", ARENA, 4));
         let world = |bytes: &[u8]| {
             let s = mcap::Summary::read(bytes).expect("summary").expect("present");
-            walls(&recorded_world(bytes, &s).expect("loads").expect("a world"))
+            walls(&recorded_world(bytes, &s).expect("loads").expect("a world").0)
         };
         assert_ne!(world(&a), world(&b), "another seed, other places");
     }
