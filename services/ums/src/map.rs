@@ -2,6 +2,8 @@
 //! positions with a most likely centre, and a heading wedge with clockwise and counter-clockwise
 //! limits, grown by each turn-and-run with the terrain's Table 3 statistics at `k` sigma.
 
+use std::f64::consts::TAU;
+
 use harvey_world::Terrain;
 
 use crate::geometry::{self, Pt};
@@ -46,10 +48,21 @@ impl Map {
         [self.heading_rad - self.cw_rad, self.heading_rad + self.ccw_rad]
     }
 
-    /// Whether a pose lies inside the map: position in the polygon, heading in the wedge.
+    /// Whether a pose lies inside the map: position in the polygon, heading in the wedge (a
+    /// wedge may reach more than half a turn either way).
     pub fn contains(&self, p: Pt, heading_rad: f64, tol: f64) -> bool {
-        let d = wrap(heading_rad - self.heading_rad);
-        geometry::contains(&self.polygon, p, tol) && d >= -self.cw_rad - 1e-12 && d <= self.ccw_rad + 1e-12
+        let from_cw_limit = (heading_rad - self.heading_rad + self.cw_rad + 1e-12).rem_euclid(TAU);
+        geometry::contains(&self.polygon, p, tol) && from_cw_limit <= self.cw_rad + self.ccw_rad + 2e-12
+    }
+
+    /// A wedge grown past a full turn says only that the heading is unknown: it is cut back to
+    /// one turn, each side in proportion.
+    fn limit_wedge(&mut self) {
+        let width = self.cw_rad + self.ccw_rad;
+        if width > TAU {
+            self.cw_rad *= TAU / width;
+            self.ccw_rad *= TAU / width;
+        }
     }
 }
 
@@ -89,6 +102,7 @@ impl Growth<'_> {
             map.ccw_rad += short;
             map.cw_rad += long;
         }
+        map.limit_wedge();
         let skitter_m = (t.skitter_ft_per_deg + self.sigmas * t.skitter_sd_ft_per_deg) * deg * FT;
         let pts: Vec<Pt> = map
             .polygon
@@ -139,6 +153,7 @@ impl Growth<'_> {
         }
         map.cw_rad += drift;
         map.ccw_rad += drift;
+        map.limit_wedge();
     }
 }
 
@@ -164,5 +179,25 @@ mod tests {
             assert!(map.contains(q, heading, 1e-9), "{q:?}");
         }
         assert!(map.area_m2() > 0.04 && map.cw_rad > 0.02 && map.ccw_rad > 0.02);
+    }
+
+    #[test]
+    fn a_wedge_holds_headings_past_half_a_turn_and_never_grows_past_a_whole_one() {
+        let mut map = Map::exact(0.0, 0.0, 0.0);
+        (map.cw_rad, map.ccw_rad) = (0.1, 4.0);
+        // 3.3 rad counter-clockwise is inside; it wraps to -2.98, which the old test refused.
+        assert!(map.contains([0.0, 0.0], 3.3, 1e-9));
+        assert!(map.contains([0.0, 0.0], -0.05, 1e-9) && map.contains([0.0, 0.0], 4.0, 1e-9));
+        assert!(!map.contains([0.0, 0.0], -0.2, 1e-9) && !map.contains([0.0, 0.0], 4.2, 1e-9));
+        let w =
+            harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway");
+        let g = Growth { terrain: &w.terrain["tile"], sigmas: 3.0 };
+        for _ in 0..200 {
+            g.run(&mut map, 3.0, false);
+            g.turn(&mut map, 1.5);
+        }
+        assert!((map.cw_rad + map.ccw_rad - TAU).abs() < 1e-9, "{} {}", map.cw_rad, map.ccw_rad);
+        let centre = map.centre;
+        assert!((-40..=40).all(|k| map.contains(centre, f64::from(k) * 0.1, 1e-9)), "every heading");
     }
 }

@@ -4,6 +4,8 @@
 //! lateral offset) to a strip and a heading interval. Each slices the polygon and the wedge,
 //! keeping them convex; a sighting that leaves nothing is rejected and the map kept.
 
+use std::f64::consts::TAU;
+
 use crate::geometry::{self, Pt};
 use crate::map::{Map, wrap};
 
@@ -52,12 +54,16 @@ fn dir(a: f64) -> Pt {
     [a.cos(), a.sin()]
 }
 
-/// Intersects the wedge with `[lo, hi]` (angles near the wedge's centre).
+/// Intersects the wedge with `[lo, hi]`, taken a whole turn either way where that overlaps the
+/// wedge more (a wide wedge reaches past half a turn from its centre).
 fn cut_wedge(map: &mut Map, lo: f64, hi: f64) -> Result<(), Rejection> {
     let [wlo, whi] = map.wedge();
     let shift = wrap(lo - map.heading_rad) - (lo - map.heading_rad);
-    let (lo, hi) = (lo + shift, hi + shift);
-    let (nlo, nhi) = (wlo.max(lo), whi.min(hi));
+    let overlap = |k: f64| (wlo.max(lo + shift + k), whi.min(hi + shift + k));
+    let (nlo, nhi) = [0.0, -TAU, TAU]
+        .into_iter()
+        .map(overlap)
+        .fold(overlap(0.0), |best, o| if o.1 - o.0 > best.1 - best.0 { o } else { best });
     if nlo > nhi {
         return Err(Rejection::NoHeading);
     }
@@ -161,4 +167,26 @@ pub fn apply(map: &Map, known: &Known, obs: &Observation, sigmas: f64) -> Result
         out.centre = geometry::nearest_point(&out.polygon, out.centre);
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_heading_past_half_a_turn_inside_a_wide_wedge_cuts_it_and_is_not_refused() {
+        let mut map = Map::exact(0.0, 0.0, 0.0);
+        (map.cw_rad, map.ccw_rad) = (1.0, 5.0);
+        // -2.2..-1.8 rad is 4.08..4.48 rad counter-clockwise: inside the wedge.
+        cut_wedge(&mut map, -2.2, -1.8).expect("inside the wedge");
+        let [lo, hi] = map.wedge();
+        assert!((lo - (TAU - 2.2)).abs() < 1e-9 && (hi - (TAU - 1.8)).abs() < 1e-9, "{lo} {hi}");
+        // A narrow wedge still refuses what lies outside it.
+        let mut narrow = Map::exact(0.0, 0.0, 0.0);
+        (narrow.cw_rad, narrow.ccw_rad) = (0.1, 0.1);
+        assert!(matches!(cut_wedge(&mut narrow, 0.5, 0.7), Err(Rejection::NoHeading)));
+        cut_wedge(&mut narrow, 0.05, 0.7).expect("overlaps");
+        let [lo, hi] = narrow.wedge();
+        assert!((lo - 0.05).abs() < 1e-9 && (hi - 0.1).abs() < 1e-9, "{lo} {hi}");
+    }
 }
