@@ -1,11 +1,12 @@
 //! `harvey replay`: runs a recording's services again on its recorded inputs and records them
-//! again. The recording carries its launch and world files; the replay launch is that launch
+//! again. The recording carries its launch, world and data files; the replay launch is that launch
 //! with the input producers (simulated DRV, bridge, camera) replaced by `harvey-replayer` as
 //! clock master.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
+use harvey_recorder::data_files::{DATA_MEDIA_TYPE, is_plain_relative};
 use harvey_recorder::{LAUNCH_MEDIA_TYPE, WORLD_MEDIA_TYPE};
 use harvey_replayer::INPUT_SERVICES;
 
@@ -35,6 +36,21 @@ pub fn prepare(recording: &Path, run_dir: &Path, rrd: bool) -> anyhow::Result<Pa
     let output = std::fs::canonicalize(run_dir)?.join("run.mcap");
     anyhow::ensure!(output != original, "the replay would overwrite {name}: choose another --run-dir");
     std::fs::write(run_dir.join("world.toml"), world)?;
+    // The launch's data files (acceptor tables...), back beside the replay's launch file.
+    for index in summary.attachment_indexes.iter().filter(|a| a.media_type == DATA_MEDIA_TYPE) {
+        anyhow::ensure!(
+            is_plain_relative(&index.name),
+            "{name}: data attachment `{}` is not a relative path inside the run folder",
+            index.name
+        );
+        let a = mcap::read::attachment(&bytes, index)
+            .with_context(|| format!("{name}: attachment `{}`", index.name))?;
+        let to = run_dir.join(&index.name);
+        if let Some(dir) = to.parent() {
+            std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        }
+        std::fs::write(&to, &a.data).with_context(|| format!("writing {}", to.display()))?;
+    }
     let text =
         replay_launch(&launch, &original, rrd).with_context(|| format!("{name}: attached launch file"))?;
     let path = run_dir.join(LAUNCH_FILE);

@@ -172,6 +172,10 @@ fn malformed_launch_files_name_file_line_and_key() {
                 .replace("name = \"encoders\"", "name = \"encoders\"\nbinary = \"harvey-no-such-service\""),
             "executable `harvey-no-such-service` not found".to_owned(),
         ),
+        (
+            PIPELINE.replace("grace_period_ms = 2000", "grace_period_ms = 2000\nfiles = [\"fsa/none.toml\"]"),
+            format!(":{}: key `launch.files`: no file", line(PIPELINE, "grace_period_ms") + 1),
+        ),
     ];
     for (text, expected) in cases {
         let prefix = common::unique_prefix("bad");

@@ -37,6 +37,10 @@ pub struct Settings {
     pub clock: ClockMode,
     /// Deterministic mode: the party that starts each tick.
     pub clock_master: Option<Spanned<String>>,
+    /// Data files the services read (acceptor tables...), relative to the launch file: the
+    /// recorder attaches them so that `harvey replay` has them.
+    #[serde(default)]
+    pub files: Vec<Spanned<String>>,
 }
 
 /// How a launch keeps time (DESIGN.md, Time and determinism).
@@ -158,7 +162,15 @@ impl LaunchFile {
             line: None,
             detail: format!("cannot read: {e}"),
         })?;
-        Self::parse(&text, path)
+        let launch = Self::parse(&text, path)?;
+        if let Some((missing, line)) = launch.data_files(&text).into_iter().find(|(f, _)| !f.is_file()) {
+            return Err(LaunchError {
+                file,
+                line: Some(line),
+                detail: format!("key `launch.files`: no file {}", missing.display()),
+            });
+        }
+        Ok(launch)
     }
 
     pub fn parse(text: &str, path: &Path) -> Result<Self, LaunchError> {
@@ -229,7 +241,24 @@ impl LaunchFile {
                 ));
             }
         }
+        for f in &parsed.launch.files {
+            if !harvey_recorder::data_files::is_plain_relative(f.get_ref()) {
+                return Err(at(
+                    f.span().start,
+                    format!(
+                        "key `launch.files`: `{}` is not a relative path inside the launch's folder",
+                        f.get_ref()
+                    ),
+                ));
+            }
+        }
         Ok(Self { path: path.to_owned(), settings: parsed.launch, services: parsed.services })
+    }
+
+    /// The `[launch] files`, resolved against the launch file's folder, with the line naming each.
+    pub fn data_files(&self, text: &str) -> Vec<(PathBuf, usize)> {
+        let base = self.path.parent().unwrap_or(Path::new("."));
+        self.settings.files.iter().map(|f| (base.join(f.get_ref()), line_of(text, f.span().start))).collect()
     }
 
     /// Deterministic mode: the clock parties in turn order, from the master round to the tail.
@@ -303,5 +332,22 @@ mod tests {
         assert!(e.starts_with("m.toml:3: key `launch.end_with`"), "{e}");
         let e = parse(&OK.replace("args", "argz")).expect_err("unknown key").to_string();
         assert!(e.contains(":7: key `service[0].argz`") || e.contains(":7: key `service[0]`"), "{e}");
+        let up = OK.replace("end_with", "files = [\"fsa/a.toml\",\n  \"../b.toml\"]\nend_with");
+        let e = parse(&up).expect_err("outside the folder").to_string();
+        assert!(e.starts_with("m.toml:4: key `launch.files`: `../b.toml` is not a relative path"), "{e}");
+    }
+
+    #[test]
+    fn data_files_resolve_beside_the_launch_file_and_must_exist() {
+        let dir = std::env::temp_dir().join(format!("harvey-files-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("fsa")).expect("tmp");
+        let text = OK.replace("end_with", "files = [\"fsa/a.toml\"]\nend_with");
+        std::fs::write(dir.join("m.toml"), &text).expect("write");
+        let e = LaunchFile::load(&dir.join("m.toml")).expect_err("missing").to_string();
+        assert!(e.contains("m.toml:3: key `launch.files`: no file") && e.contains("fsa/a.toml"), "{e}");
+        std::fs::write(dir.join("fsa/a.toml"), "x").expect("write");
+        let l = LaunchFile::load(&dir.join("m.toml")).expect("loads");
+        assert_eq!(l.data_files(&text), [(dir.join("fsa/a.toml"), 3)]);
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -9,6 +9,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 pub mod compare;
+pub mod data_files;
 pub mod draw;
 pub mod export;
 pub mod recover;
@@ -165,13 +166,19 @@ impl Recorder {
         self.attach(name, LAUNCH_MEDIA_TYPE, text)
     }
 
-    fn attach(&mut self, name: &str, media_type: &str, text: &str) -> Result<(), RecordError> {
+    /// Stores a data file the launch names (`data_files.rs`), under its path relative to the
+    /// launch file.
+    pub fn attach_data(&mut self, name: &str, bytes: &[u8]) -> Result<(), RecordError> {
+        self.attach(name, data_files::DATA_MEDIA_TYPE, bytes)
+    }
+
+    fn attach(&mut self, name: &str, media_type: &str, data: impl AsRef<[u8]>) -> Result<(), RecordError> {
         let a = mcap::Attachment {
             log_time: 0,
             create_time: 0,
             name: name.to_owned(),
             media_type: media_type.to_owned(),
-            data: std::borrow::Cow::Borrowed(text.as_bytes()),
+            data: std::borrow::Cow::Borrowed(data.as_ref()),
         };
         self.writer.attach(&a).map_err(|e| self.err(e))
     }

@@ -12,8 +12,8 @@ use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waitable, Waiter};
 use harvey_cdr::Ros2Msg;
 use harvey_msgs::{Message, Topic, topics};
-use harvey_recorder::Recorder;
 use harvey_recorder::rrd::RrdWriter;
+use harvey_recorder::{Recorder, data_files};
 
 mod taps;
 mod writer;
@@ -74,6 +74,12 @@ fn main() -> anyhow::Result<()> {
         let text = std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
         let name = path.file_name().map_or("launch.toml".into(), |n| n.to_string_lossy().into_owned());
         rec.attach_launch(&name, &text)?;
+        let base = path.parent().unwrap_or(std::path::Path::new("."));
+        for file in data_files::named_in(&text, &path.display().to_string()).map_err(anyhow::Error::msg)? {
+            let at = base.join(&file);
+            let bytes = std::fs::read(&at).with_context(|| format!("reading {}", at.display()))?;
+            rec.attach_data(&file, &bytes)?;
+        }
     }
     let rrd = args.rrd.as_ref().map(|p| RrdWriter::create(p, world.as_ref())).transpose()?;
     let bus = Bus::join("recorder")?;
