@@ -31,10 +31,7 @@ fn run(mission: &Path, tag: &str) -> PathBuf {
 
 /// The number in "identical: N messages ...".
 fn agreed(out: &Output) -> usize {
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line =
-        stdout.lines().find(|l| l.starts_with("identical: ")).unwrap_or_else(|| panic!("{}", text(out)));
-    line.split_whitespace().nth(1).and_then(|n| n.parse().ok()).expect("a count")
+    common::agreed(out).unwrap_or_else(|| panic!("no count of identical messages: {}", text(out)))
 }
 
 fn diff(a: &Path, b: &Path) -> Output {
@@ -74,18 +71,7 @@ fn the_same_seed_records_the_same_messages_and_another_seed_does_not() {
 #[test]
 fn the_reference_recording_replays_exactly() {
     let reference = common::repo().join("recordings/reference/default.mcap");
-    let (prefix, dir) = (common::unique_prefix("replay"), common::scratch("replay"));
-    let out = common::harvey(&[
-        "replay",
-        reference.to_str().expect("utf8"),
-        "--check",
-        "--prefix",
-        &prefix,
-        "--run-dir",
-        dir.to_str().expect("utf8"),
-    ])
-    .output()
-    .expect("replay runs");
+    let (out, prefix, dir) = common::replay_check(&reference, "replay");
     assert_eq!(
         out.status.code(),
         Some(0),

@@ -151,3 +151,29 @@ pub fn holds(m: &harvey_msgs::UncertaintyMap, x: f64, y: f64, th: f64, tol: f64)
         - std::f64::consts::PI;
     inside && d >= -m.heading_cw_rad - 1e-9 && d <= m.heading_ccw_rad + 1e-9
 }
+
+/// `harvey replay --check` of `recording`, under its own bus prefix and scratch run folder.
+#[allow(dead_code)]
+pub fn replay_check(recording: &Path, tag: &str) -> (std::process::Output, String, PathBuf) {
+    let (prefix, dir) = (unique_prefix(tag), scratch(tag));
+    let out = harvey(&[
+        "replay",
+        recording.to_str().expect("utf8"),
+        "--check",
+        "--prefix",
+        &prefix,
+        "--run-dir",
+        dir.to_str().expect("utf8"),
+    ])
+    .output()
+    .expect("replay runs");
+    (out, prefix, dir)
+}
+
+/// How many messages a `--check` or `harvey diff` found identical (its `identical: N` line).
+#[allow(dead_code)]
+pub fn agreed(out: &std::process::Output) -> Option<usize> {
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout.lines().find(|l| l.starts_with("identical: "))?;
+    line.split_whitespace().nth(1)?.parse().ok()
+}
