@@ -133,6 +133,7 @@ pub fn bench_hough(img: &GrayBuf, size: &str, rows: &mut Vec<Row>) {
         [30.0, 35.0, 40.0, 45.0, 50.0].iter().map(|&scale| Hypothesis { scale, rotation: 0.0 }).collect();
     let model = DockModel::frame_with_post();
     let dims = [img.width, img.height];
+    let mut votes = Vec::new();
     for (scope, win, lines) in lines(img, 192) {
         rows.push(measure(
             Row::new(
@@ -143,7 +144,7 @@ pub fn bench_hough(img: &GrayBuf, size: &str, rows: &mut Vec<Row>) {
                 Rect::default(),
             ),
             || {
-                black_box(find_dock(&lines, &model, &hyps, dims, 4.0));
+                black_box(find_dock(&lines, &model, &hyps, dims, 4.0, &mut votes));
             },
             || {
                 black_box(reference_geometry::hough(&lines, &model, &hyps, dims));

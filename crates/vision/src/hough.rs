@@ -51,19 +51,22 @@ pub struct DockMatch {
 
 /// The constrained Hough transform: each image line votes, for every hypothesis and every
 /// model segment of like orientation and length, for where the reference point must then be;
-/// all hypotheses share one Hough space in image coordinates, `cell` pixels a bin.
+/// all hypotheses share one Hough space in image coordinates, `cell` pixels a bin. `votes` is
+/// the caller's scratch space (kept between calls, it stops allocating once grown).
 pub fn find_dock(
     lines: &[Line],
     model: &DockModel,
     hypotheses: &[Hypothesis],
     image: [usize; 2],
     cell: f32,
+    votes: &mut Vec<f32>,
 ) -> Option<DockMatch> {
     if model.segments.is_empty() || hypotheses.is_empty() || cell.is_nan() || cell < 1.0 {
         return None;
     }
     let (bw, bh) = ((image[0] as f32 / cell).ceil() as usize, (image[1] as f32 / cell).ceil() as usize);
-    let mut votes = vec![0f32; bw * bh];
+    votes.clear();
+    votes.resize(bw * bh, 0.0);
     let model_len: f32 = model.segments.iter().map(|s| (s[1][0] - s[0][0]).hypot(s[1][1] - s[0][1])).sum();
     for hyp in hypotheses {
         let (c, s) = (hyp.rotation.cos(), hyp.rotation.sin());
@@ -247,11 +250,13 @@ mod tests {
             .map(|&scale| Hypothesis { scale, rotation: 0.05 })
             .collect();
         let truth = [321.0, 243.0];
-        let m = find_dock(&scene(truth, 41.0, 0.06, true), &dock(), &hyps, [640, 480], 4.0).expect("found");
+        let m = find_dock(&scene(truth, 41.0, 0.06, true), &dock(), &hyps, [640, 480], 4.0, &mut Vec::new())
+            .expect("found");
         assert!((m.at[0] - truth[0]).hypot(m.at[1] - truth[1]) < 4.0, "{m:?}");
         assert!(m.certainty > 0.6, "{m:?}");
         assert_eq!(hyps[m.hypothesis].scale, 40.0, "{m:?}");
-        let none = find_dock(&scene(truth, 41.0, 0.06, false), &dock(), &hyps, [640, 480], 4.0);
+        let none =
+            find_dock(&scene(truth, 41.0, 0.06, false), &dock(), &hyps, [640, 480], 4.0, &mut Vec::new());
         assert!(none.is_none_or(|m| m.certainty < 0.3), "{none:?}");
     }
 

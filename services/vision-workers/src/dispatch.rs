@@ -32,6 +32,7 @@ pub struct Dispatcher {
     activity: std::collections::BTreeMap<u32, ActivityDetector>,
     dock_model: DockModel,
     hypotheses: Vec<Hypothesis>,
+    dock_votes: Vec<f32>,
     poles: Vec<[f32; 6]>,
     seq: u64,
 }
@@ -68,6 +69,7 @@ impl Dispatcher {
             activity: std::collections::BTreeMap::new(),
             dock_model: DockModel::frame_with_post(),
             hypotheses: Vec::new(),
+            dock_votes: Vec::new(),
             poles: Vec::new(),
             seq: 0,
         }
@@ -193,7 +195,8 @@ impl Dispatcher {
                 }));
                 let p = FlfParams { min_length: 6.0, ..FlfParams::default() };
                 let lines = self.flf.lines(&img, window, &p).map_err(|e| status_of(&e))?;
-                let found = find_dock(lines, &self.dock_model, &self.hypotheses, [w, ht], 4.0);
+                let found =
+                    find_dock(lines, &self.dock_model, &self.hypotheses, [w, ht], 4.0, &mut self.dock_votes);
                 if let Some(m) = found.filter(|m| m.certainty >= min_certainty) {
                     let scale = self.hypotheses[m.hypothesis].scale;
                     let [left, right] = post_heights(lines, m.at, scale);

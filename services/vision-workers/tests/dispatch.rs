@@ -214,6 +214,11 @@ fn the_dock_is_recognised_on_the_bus_with_its_posts_heights() {
     dock.params[..5].copy_from_slice(&[(f * 0.5 / 4.6) as f32, (f * 0.5 / 2.6) as f32, 5.0, 0.0, 0.6]);
     let found = d.answer(&h, &px, &dock);
     assert_eq!(status(&found), VisionStatus::Found, "{found:?}");
+    // Warm now: the same request again allocates nothing (the Hough space is kept).
+    let before = ALLOCATIONS.with(Cell::get);
+    let again = d.answer(&h, &px, &dock);
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0, "allocations while finding the dock");
+    assert_eq!(again.items[0], found.items[0]);
     let [u, v, certainty, scale, left, right] = found.items[0].values;
     let centre = w.camera.project(640, 480, pose, [13.6, 0.0, 0.45]).expect("in front");
     assert!((u as f64 - centre[0]).abs() < 3.0 && (v as f64 - centre[1]).abs() < 3.0, "{found:?} {centre:?}");
@@ -245,13 +250,16 @@ fn coded_poles_are_recognised_with_their_range_and_code() {
     let mut r = Renderer::new(&w, 640, 480, Encoding::Mono8);
     let mut px = vec![0u8; r.frame_bytes()];
     let h = FrameHeader::new(1, 100_000_000, 640, 480, Encoding::Mono8);
-    let mut seen = 0;
+    let (mut seen, mut with_poles) = (0, None);
     // From the start, looking round in steps of half the field of view: every pole in view and
     // unhidden within 10 m is found with its code and its range to within 3 %.
     for k in 0..12 {
         let pose = [w.start.x_m, w.start.y_m, f64::from(k) * 30f64.to_radians()];
         r.render(&w, pose, &mut px).expect("renders");
         let res = d.answer(&h, &px, &request(12, VisionAlgorithm::Poles));
+        if res.count > 0 {
+            with_poles.get_or_insert(pose);
+        }
         for item in &res.items[..res.count as usize] {
             let [u, range, code, ..] = item.values;
             let p = poles.iter().find(|p| p.code == code as u32).expect("a real code");
@@ -266,6 +274,12 @@ fn coded_poles_are_recognised_with_their_range_and_code() {
         }
     }
     assert!(seen >= 8, "{seen} sightings");
+    // Warm now: another look at poles allocates nothing.
+    r.render(&w, with_poles.expect("a look with poles"), &mut px).expect("renders");
+    let before = ALLOCATIONS.with(Cell::get);
+    let again = d.answer(&h, &px, &request(12, VisionAlgorithm::Poles));
+    assert_eq!(ALLOCATIONS.with(Cell::get) - before, 0, "allocations while finding poles");
+    assert_eq!(status(&again), VisionStatus::Found, "{again:?}");
     let hallway = Dispatcher::new(hallway()).answer(&h, &px, &request(12, VisionAlgorithm::Poles));
     assert_eq!(status(&hallway), VisionStatus::BadParameter, "no [poles] in the hallway");
 }
