@@ -12,6 +12,7 @@ use harvey_msgs::{
     VisionStatus,
 };
 
+use crate::dock_pose::{face_distance, pose_from_dock};
 use crate::drive::{self, DriveParams, Vectors};
 use crate::fsa::{Fsa, Trigger};
 use crate::mission::DockingGoal;
@@ -43,38 +44,6 @@ pub struct Docking {
     /// The believed heading when the target was last seen, and ticks since the last fix asked.
     target_heading: f64,
     since_fix: u32,
-}
-
-/// The robot's pose from the dock recognised in the image (the inverse perspective of 004
-/// §4.1.3 on the Hough's frame): the end posts' apparent heights `item[4..6]` give their depths,
-/// their difference the angle the face is seen at, their mean the frame's depth, and the frame
-/// centre's column `item[0]` its bearing. `None` without both posts, or with a post whose height
-/// disagrees with the match's scale by more than a third (a post cut short or lengthened by
-/// something in front of the dock), or seen at more than 35 degrees.
-pub fn pose_from_dock(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64; 6]) -> Option<Pose2> {
-    let [u, _, _, scale, left, right] = *item;
-    let plausible = |h: f64| (0.75 * scale..1.33 * scale).contains(&h);
-    if !plausible(left) || !plausible(right) {
-        return None;
-    }
-    let post_m = g.frame_width_m / 2.0;
-    let (z_left, z_right) = (focal_px * post_m / left, focal_px * post_m / right);
-    let sin_turned = (z_left - z_right) / g.frame_width_m;
-    if sin_turned.abs() > 0.57 {
-        return None;
-    }
-    let turned = sin_turned.asin();
-    let heading = crate::recover::wrap(g.dock_facing_deg.to_radians() + std::f64::consts::PI + turned);
-    let bearing = ((centre_u - u) / focal_px).atan();
-    let ray = (z_left + z_right) / 2.0 / bearing.cos();
-    let a = heading + bearing;
-    Some(Pose2 { x_m: g.dock_m[0] - ray * a.cos(), y_m: g.dock_m[1] - ray * a.sin(), heading_rad: heading })
-}
-
-/// The face's distance from `at` along the face's normal (the robot's centre to the face).
-fn face_distance(g: &DockingGoal, at: Pose2) -> f64 {
-    let n = g.dock_facing_deg.to_radians();
-    (at.x_m - g.dock_m[0]) * n.cos() + (at.y_m - g.dock_m[1]) * n.sin()
 }
 
 impl Docking {
@@ -242,100 +211,21 @@ impl Docking {
     ) -> (Option<VisionRequest>, MotionCommand, BehaviourState) {
         self.odometry = odometry;
         let at = self.believed();
-        let here = V2::new(at.x_m, at.y_m);
         let d = face_distance(&self.g, at);
-        let mut request = None;
         let mut parts = [V2::default(); 5];
-        match self.perception() {
-            "phototropic" => {
-                let moved = self
-                    .hough_at
-                    .is_none_or(|p| (p[0] - at.x_m).hypot(p[1] - at.y_m) >= self.g.retry_after_m);
-                if d <= self.g.hough_range_m && moved {
-                    self.trigger(Trigger::Terminal);
-                    self.seq.forget();
-                } else {
-                    if !self.seq.waiting() {
-                        request =
-                            Some(self.seq.request(now, VisionAlgorithm::Phototropic, [0.0; 4], [0.0; 8]));
-                    }
-                    let goal = match self.light_rad {
-                        Some(a) => here.plus(V2::new(a.cos(), a.sin()).scale(5.0)),
-                        None => V2::new(self.g.dock_m[0], self.g.dock_m[1]),
-                    };
-                    parts[0] = move_to_goal(here, goal, self.g.ballistic_mps);
-                    if let Some(ring) = &self.ring {
-                        parts[1] = drive::avoid_echoes(ring, at, self.sensor_ring_m, &self.drive);
-                    }
-                    parts[2] = self.noise.vector();
-                }
-            }
+        let request = match self.perception() {
+            "phototropic" => self.phototropic(at, d, now, &mut parts),
             "hough-dock" if !self.seq.waiting() => {
-                request = Some(self.hough_request(now, d));
                 self.hough_at = Some([at.x_m, at.y_m]);
+                Some(self.hough_request(now, d))
             }
-            "region-tracking" => {
-                self.since_fix += 1;
-                if let Some([u, v, area]) = self.target {
-                    // Where the target is now, the robot having turned since it was seen.
-                    let u = u + self.focal_px * (at.heading_rad - self.target_heading);
-                    let side = area.sqrt();
-                    let range = self.focal_px * self.g.target_side_m / side.max(1.0);
-                    let bearing = at.heading_rad + ((self.centre_px[0] - u) / self.focal_px).atan();
-                    // Channelled onto the dock's axis (004 §4.2: the approach zone): the target
-                    // seen fixes the axis, and the robot steers for a point on it `lead_m` nearer
-                    // the dock than itself.
-                    let target = here.plus(V2::new(bearing.cos(), bearing.sin()).scale(range));
-                    let n = self.g.dock_facing_deg.to_radians();
-                    let n = V2::new(n.cos(), n.sin());
-                    let out = here.minus(target);
-                    let along = out.x * n.x + out.y * n.y;
-                    let goal = target.plus(n.scale((along - self.g.lead_m).max(self.g.final_m)));
-                    // ...but never so far off the target that it would leave the image.
-                    let to_goal = goal.minus(here);
-                    let off = crate::recover::wrap(to_goal.y.atan2(to_goal.x) - bearing);
-                    let keep = self.g.keep_in_view_deg.to_radians();
-                    let dir = bearing + off.clamp(-keep, keep);
-                    let speed = self.g.controlled_mps.min(0.5 * (range - self.g.final_m)).max(0.0);
-                    parts[0] = V2::new(dir.cos(), dir.sin()).scale(speed);
-                    let frame_in_view = d > self.g.fix_beyond_m;
-                    if !self.seq.waiting() && frame_in_view && self.since_fix >= self.g.fix_every_ticks {
-                        // Now and then a fix from the frame, while it is in view.
-                        self.since_fix = 0;
-                        request = Some(self.hough_request(now, d));
-                    } else if !self.seq.waiting() {
-                        let half = (2.0 * side).max(24.0);
-                        let window = [u - half, v - half, u + half, v + half].map(|x| x as f32);
-                        let c = [self.centre_px[0] * 2.0, self.centre_px[1] * 2.0];
-                        let window = [
-                            window[0].max(0.0),
-                            window[1].max(0.0),
-                            window[2].min(c[0] as f32),
-                            window[3].min(c[1] as f32),
-                        ];
-                        let g = self.g.target_grey.map(|x| x as f32);
-                        request = Some(self.seq.request(
-                            now,
-                            VisionAlgorithm::RegionSegmenter,
-                            window,
-                            [g[0], g[1], 10.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-                        ));
-                    }
-                }
+            "region-tracking" => self.region_tracking(at, d, now, &mut parts),
+            "sonar-positioning" => {
+                self.sonar_positioning(at, &mut parts);
+                None
             }
-            "sonar-positioning" => match self.range_ahead() {
-                Some(r) if r < self.g.too_close_m => self.trigger(Trigger::Fatal),
-                Some(r) if r <= self.g.final_m => self.trigger(Trigger::Terminal),
-                Some(r) => {
-                    // Hold the heading: move-to-goal straight ahead, slowing to the mark.
-                    let speed = self.g.controlled_mps.min(r - self.g.final_m + 0.02);
-                    let ahead = V2::new(at.heading_rad.cos(), at.heading_rad.sin());
-                    parts[0] = ahead.scale(speed);
-                }
-                None => {}
-            },
-            _ => {}
-        }
+            _ => None,
+        };
         let vectors: Vectors = drive::vectors(parts, &self.drive);
         let (v, w) = if self.perception() == "sonar-positioning" {
             (vectors.sum.norm(), 0.0)
@@ -347,45 +237,88 @@ impl Docking {
         let (command, state) = self.seq.output(at, now, &vectors, (v, w), achieved);
         (request, command, state)
     }
-}
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn goal() -> DockingGoal {
-        let text =
-            std::fs::read_to_string(format!("{}/../../missions/docking.toml", env!("CARGO_MANIFEST_DIR")))
-                .expect("readable");
-        crate::mission::parse(&text, "docking.toml").expect("parses").docking.expect("docking")
-    }
-
-    /// The Hough's item for a robot at `at`: frame centre column, scale, and the end posts'
-    /// heights (left post at y = +0.5, on the robot's left when it faces the dock).
-    fn seen_from(at: Pose2, f: f64) -> [f64; 6] {
-        let (c, s) = (at.heading_rad.cos(), at.heading_rad.sin());
-        let depth = |p: [f64; 2]| (p[0] - at.x_m) * c + (p[1] - at.y_m) * s;
-        let left_of = |p: [f64; 2]| -(p[0] - at.x_m) * s + (p[1] - at.y_m) * c;
-        let centre = [13.6, 0.0];
-        let u = 320.0 - f * left_of(centre) / depth(centre);
-        [u, 200.0, 0.9, f * 0.5 / depth(centre), f * 0.5 / depth([13.6, 0.5]), f * 0.5 / depth([13.6, -0.5])]
-    }
-
-    #[test]
-    fn the_frame_s_posts_and_centre_give_the_robot_s_pose() {
-        let g = goal();
-        for truth in [
-            Pose2 { x_m: 10.0, y_m: -0.5, heading_rad: 10f64.to_radians() },
-            Pose2 { x_m: 9.0, y_m: 1.2, heading_rad: -20f64.to_radians() },
-            Pose2 { x_m: 11.5, y_m: 0.0, heading_rad: 0.0 },
-        ] {
-            let p = pose_from_dock(&g, 554.0, 320.0, &seen_from(truth, 554.0)).expect("a pose");
-            assert!((p.x_m - truth.x_m).abs() < 1e-9 && (p.y_m - truth.y_m).abs() < 1e-9, "{p:?} {truth:?}");
-            assert!((p.heading_rad - truth.heading_rad).abs() < 1e-9, "{p:?} {truth:?}");
+    /// q0, ballistic: move-to-goal towards the lamp's bearing (the dock's place until the lamp is
+    /// seen), avoid-static-obstacle and noise, until the dock is believed within Hough range of
+    /// a place the Hough has not been tried from.
+    fn phototropic(&mut self, at: Pose2, d: f64, now: u64, parts: &mut [V2; 5]) -> Option<VisionRequest> {
+        let moved =
+            self.hough_at.is_none_or(|p| (p[0] - at.x_m).hypot(p[1] - at.y_m) >= self.g.retry_after_m);
+        if d <= self.g.hough_range_m && moved {
+            self.trigger(Trigger::Terminal);
+            self.seq.forget();
+            return None;
         }
-        // A post cut short by something in front of it: no pose.
-        let mut cut = seen_from(Pose2 { x_m: 10.0, y_m: 0.0, heading_rad: 0.0 }, 554.0);
-        cut[4] *= 0.6;
-        assert_eq!(pose_from_dock(&g, 554.0, 320.0, &cut), None);
+        let request = (!self.seq.waiting())
+            .then(|| self.seq.request(now, VisionAlgorithm::Phototropic, [0.0; 4], [0.0; 8]));
+        let here = V2::new(at.x_m, at.y_m);
+        let goal = match self.light_rad {
+            Some(a) => here.plus(V2::new(a.cos(), a.sin()).scale(5.0)),
+            None => V2::new(self.g.dock_m[0], self.g.dock_m[1]),
+        };
+        parts[0] = move_to_goal(here, goal, self.g.ballistic_mps);
+        if let Some(ring) = &self.ring {
+            parts[1] = drive::avoid_echoes(ring, at, self.sensor_ring_m, &self.drive);
+        }
+        parts[2] = self.noise.vector();
+        request
+    }
+
+    /// q2, controlled: towards the tracked target, channelled onto the dock's axis; asks for the
+    /// target again, or now and then for a fix from the frame while it is in view.
+    fn region_tracking(&mut self, at: Pose2, d: f64, now: u64, parts: &mut [V2; 5]) -> Option<VisionRequest> {
+        self.since_fix += 1;
+        let [u, v, area] = self.target?;
+        let here = V2::new(at.x_m, at.y_m);
+        // Where the target is now, the robot having turned since it was seen.
+        let u = u + self.focal_px * (at.heading_rad - self.target_heading);
+        let side = area.sqrt();
+        let range = self.focal_px * self.g.target_side_m / side.max(1.0);
+        let bearing = at.heading_rad + ((self.centre_px[0] - u) / self.focal_px).atan();
+        // Channelled onto the dock's axis (004 §4.2: the approach zone): the target seen fixes
+        // the axis, and the robot steers for a point on it `lead_m` nearer the dock than itself.
+        let target = here.plus(V2::new(bearing.cos(), bearing.sin()).scale(range));
+        let n = self.g.dock_facing_deg.to_radians();
+        let n = V2::new(n.cos(), n.sin());
+        let out = here.minus(target);
+        let along = out.x * n.x + out.y * n.y;
+        let goal = target.plus(n.scale((along - self.g.lead_m).max(self.g.final_m)));
+        // ...but never so far off the target that it would leave the image.
+        let to_goal = goal.minus(here);
+        let off = crate::recover::wrap(to_goal.y.atan2(to_goal.x) - bearing);
+        let keep = self.g.keep_in_view_deg.to_radians();
+        let dir = bearing + off.clamp(-keep, keep);
+        let speed = self.g.controlled_mps.min(0.5 * (range - self.g.final_m)).max(0.0);
+        parts[0] = V2::new(dir.cos(), dir.sin()).scale(speed);
+        if self.seq.waiting() {
+            return None;
+        }
+        let frame_in_view = d > self.g.fix_beyond_m;
+        if frame_in_view && self.since_fix >= self.g.fix_every_ticks {
+            // Now and then a fix from the frame, while it is in view.
+            self.since_fix = 0;
+            return Some(self.hough_request(now, d));
+        }
+        let half = (2.0 * side).max(24.0);
+        let c = [self.centre_px[0] * 2.0, self.centre_px[1] * 2.0];
+        let window = [(u - half).max(0.0), (v - half).max(0.0), (u + half).min(c[0]), (v + half).min(c[1])]
+            .map(|x| x as f32);
+        let g = self.g.target_grey.map(|x| x as f32);
+        let params = [g[0], g[1], 10.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        Some(self.seq.request(now, VisionAlgorithm::RegionSegmenter, window, params))
+    }
+
+    /// q3: hold the heading, move-to-goal straight ahead slowing to the mark, until the sonar
+    /// says the dock is at the final distance (too close is fatal).
+    fn sonar_positioning(&mut self, at: Pose2, parts: &mut [V2; 5]) {
+        match self.range_ahead() {
+            Some(r) if r < self.g.too_close_m => self.trigger(Trigger::Fatal),
+            Some(r) if r <= self.g.final_m => self.trigger(Trigger::Terminal),
+            Some(r) => {
+                let speed = self.g.controlled_mps.min(r - self.g.final_m + 0.02);
+                parts[0] = V2::new(at.heading_rad.cos(), at.heading_rad.sin()).scale(speed);
+            }
+            None => {}
+        }
     }
 }

@@ -4,6 +4,7 @@
 //! and `behaviour.rs` the acceptor-sequenced behaviours, which drive instead of a script.
 
 pub mod behaviour;
+pub mod dock_pose;
 pub mod docking;
 pub mod drive;
 pub mod fsa;
