@@ -90,6 +90,35 @@ pub fn window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option
     (b[0].is_finite() && win.u0 < win.u1 && win.v0 < win.v1).then_some(win)
 }
 
+/// The Expecter's window for the frame the vision workers will search it in, one tick after the
+/// odometry the map was grown from: the union of the windows from the map now and from the map
+/// moved on by the last tick's motion (`turn_rad`, then `run_m` along the heading) once more. A
+/// turn at 30 deg/s moves a landmark some 15 px in a 50 ms tick, more than the margins.
+pub fn window_ahead(
+    map: &Map,
+    view: View<'_>,
+    l: &Landmark,
+    margin_px: f64,
+    (turn_rad, run_m): (f64, f64),
+) -> Option<Window> {
+    let now = window(map, view, l, margin_px);
+    if turn_rad == 0.0 && run_m == 0.0 {
+        return now;
+    }
+    let mut next = map.clone();
+    next.heading_rad += turn_rad;
+    let (dx, dy) = (run_m * next.heading_rad.cos(), run_m * next.heading_rad.sin());
+    for p in next.polygon.iter_mut().chain(std::iter::once(&mut next.centre)) {
+        (p[0], p[1]) = (p[0] + dx, p[1] + dy);
+    }
+    match (now, window(&next, view, l, margin_px)) {
+        (Some(a), Some(b)) => {
+            Some(Window { u0: a.u0.min(b.u0), v0: a.v0.min(b.v0), u1: a.u1.max(b.u1), v1: a.v1.max(b.v1) })
+        }
+        (a, b) => a.or(b),
+    }
+}
+
 /// The window a disk of the same uncertainty (centred on the map's centre, reaching its
 /// farthest vertex) would give: the model 002 §3.1 argues against.
 pub fn disk_window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option<Window> {
@@ -101,4 +130,29 @@ pub fn disk_window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> O
         .collect();
     let as_map = Map { polygon: disk, ..map.clone() };
     window(&as_map, view, l, margin_px)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_window_covers_where_the_landmark_will_be_a_tick_into_a_turn() {
+        let w =
+            harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway");
+        let l = w.landmarks.iter().find(|l| l.name == "end-wall-corner").expect("landmark");
+        let view = View { camera: &w.camera, width_px: 640, height_px: 480 };
+        let map = Map::exact(0.0, 0.0, 0.0);
+        // Turning left at 30 deg/s: 1.5 degrees a 50 ms tick.
+        let turn = 1.5f64.to_radians();
+        let now = window(&map, view, l, 4.0).expect("in view");
+        let ahead = window_ahead(&map, view, l, 4.0, (turn, 0.0)).expect("in view");
+        let m = w.camera.calibration(640, 480);
+        let foot = project_with(&m, [0.0, 0.0, turn.cos(), turn.sin()], l.position_m).expect("in front");
+        assert!(!now.contains(foot), "the map's own window misses it: {now:?} {foot:?}");
+        assert!(ahead.contains(foot), "{ahead:?} {foot:?}");
+        assert!(ahead.u0 <= now.u0 && ahead.u1 >= now.u1 && ahead.v0 <= now.v0 && ahead.v1 >= now.v1);
+        // Standing still: the same window.
+        assert_eq!(window_ahead(&map, view, l, 4.0, (0.0, 0.0)), Some(now));
+    }
 }

@@ -273,13 +273,15 @@ impl Ums {
         }
     }
 
-    /// Windows for the landmarks of the meadow under the map's centre that are active from it
-    /// (sequence number 0: `on_odometry` numbers what it publishes).
+    /// Windows for the landmarks of the meadow under the map's centre that are active from it,
+    /// for the next frame (`expecter::window_ahead`); sequence number 0: `on_odometry` numbers
+    /// what it publishes.
     pub fn expectations(&self, stamp_ns: u64) -> Vec<Expectation> {
         let m = &self.map;
         let Some(meadow) = self.world.meadow_at(m.centre[0], m.centre[1]) else { return Vec::new() };
         let (w, h) = self.config.image_px;
         let view = View { camera: &self.world.camera, width_px: w, height_px: h };
+        let last_step = self.history.back().map_or((0.0, 0.0), |(_, _, s)| (s.turn_rad, s.run_m));
         self.world
             .landmarks
             .iter()
@@ -289,7 +291,7 @@ impl Ums {
                     && l.active_from(m.centre[0], m.centre[1], m.heading_rad.to_degrees())
             })
             .filter_map(|(i, l)| {
-                let win = expecter::window(m, view, l, margin_px(l.strategy))?;
+                let win = expecter::window_ahead(m, view, l, margin_px(l.strategy), last_step)?;
                 let class = match l.class {
                     LandmarkClass::I => 1,
                     LandmarkClass::II => 2,
