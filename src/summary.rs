@@ -175,7 +175,7 @@ impl RunStats {
         }
         if let Some((visits, within_m)) = &self.pole_visits {
             let times: Vec<f64> = visits.iter().flatten().copied().collect();
-            let last = times.iter().copied().fold(None, |a: Option<f64>, t| Some(a.map_or(t, |a| a.max(t))));
+            let last = times.iter().copied().reduce(f64::max);
             out += &format!(
                 "  poles visited {} of {} (true path within {within_m:.2} m of a pole){}\n",
                 times.len(),

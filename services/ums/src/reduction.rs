@@ -60,7 +60,7 @@ fn cut_wedge(map: &mut Map, lo: f64, hi: f64) -> Result<(), Rejection> {
     let [wlo, whi] = map.wedge();
     let shift = wrap(lo - map.heading_rad) - (lo - map.heading_rad);
     let overlap = |k: f64| (wlo.max(lo + shift + k), whi.min(hi + shift + k));
-    let (nlo, nhi) = [0.0, -TAU, TAU]
+    let (nlo, nhi) = [-TAU, TAU]
         .into_iter()
         .map(overlap)
         .fold(overlap(0.0), |best, o| if o.1 - o.0 > best.1 - best.0 { o } else { best });
