@@ -2,12 +2,12 @@
 //! acceptor (missions/fsa/docking.toml). A cart pushed across in front of the dock breaks the
 //! tracking, and the robot recovers as the paper's did: q2 -> q1 (the Hough cannot see the dock)
 //! -> q0 (move a bit) -> q1 -> q2; it docks within an inch of the mark.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 
+use harvey_geometry::INCH;
 use harvey_msgs::{BehaviourState, TruePose};
-
-const INCH: f64 = 0.0254;
 
 #[test]
 fn docking_recovers_from_the_occluding_cart_and_ends_within_an_inch() {

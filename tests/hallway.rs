@@ -1,13 +1,12 @@
 //! 000 §5.5, Fig. 11 as missions: the straight run down the hallway in 2 ft increments. Servoed
 //! on the exit sign after each increment, the robot stays within 0.3 in of the line over 40 ft;
 //! open loop (002 Table 3's drift), it is over 2 in off by 18-20 ft.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 
+use harvey_geometry::{FT, INCH};
 use harvey_msgs::{MissionStatus, ServoCorrection, ServoLevel, TruePose, VisionResult, VisionStatus};
-
-const INCH: f64 = 0.0254;
-const FT: f64 = 0.3048;
 
 /// What a run recorded: the true poses (x, y along and across the line, which is the x axis),
 /// the executive's correlation results, its corrections, and the servo levels it reported.

@@ -2,12 +2,12 @@
 //! the start of the hall while the executive believes it 3 or 6 inches to one side; from that
 //! belief it finds the mission's landmark vertices by correlation and refines its pose, to
 //! within 1.5 in of the truth each time.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 
+use harvey_geometry::INCH;
 use harvey_msgs::{PoseFix, TruePose};
-
-const INCH: f64 = 0.0254;
 
 #[test]
 fn expected_poses_inches_off_are_refined_to_within_an_inch_and_a_half() {

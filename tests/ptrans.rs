@@ -2,12 +2,12 @@
 //! goal over the hallway world's locale graph (through the lab's door, down the hall, through
 //! the office's door), checks a milestone after each subgoal, fixes the pose from landmark
 //! vertices on the way (000 §5.6), and ends within an inch of Ted's desk.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 
+use harvey_geometry::INCH;
 use harvey_msgs::{CheckOutcome, PlanSketch, PlanStage, Pose2, PoseFix, TruePose, UncertaintyMap};
-
-const INCH: f64 = 0.0254;
 
 /// The true pose at (or just before) `stamp_ns`.
 fn truth_at(truth: &[(u64, Pose2)], stamp_ns: u64) -> Pose2 {

@@ -22,15 +22,8 @@ macro_rules! message {
 }
 pub(crate) use message;
 
-/// A planar pose: position in metres and heading in radians (counter-clockwise from +x).
-#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
-#[repr(C)]
-#[type_name("harvey_msgs/Pose2")]
-pub struct Pose2 {
-    pub x_m: f64,
-    pub y_m: f64,
-    pub heading_rad: f64,
-}
+/// The planar pose (`harvey_geometry::Pose2`) travels in messages as it is.
+pub use harvey_geometry::Pose2;
 
 /// The simulator's true pose of the robot (`sim/truth`): for the renderer and for evaluation only.
 #[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]

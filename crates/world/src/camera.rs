@@ -2,7 +2,7 @@
 //! (x forward, y left, z up, metres) to image coordinates, for any image size. The renderer and
 //! the Expecter use the same model, so what is drawn is where it is expected.
 
-use crate::Camera;
+use crate::{Camera, Pose2};
 
 impl Camera {
     /// Focal length in pixels for an image `width_px` wide (square pixels).
@@ -20,17 +20,10 @@ impl Camera {
         [[cx, cy, 1.0], [-f, 0.0, 0.0], [0.0, -f, 0.0], [0.0, f * self.height_m, 0.0]]
     }
 
-    /// Where a world point appears for a robot at `pose = [x, y, heading]`; `None` behind the
-    /// camera.
-    pub fn project(
-        &self,
-        width_px: u32,
-        height_px: u32,
-        pose: [f64; 3],
-        world_m: [f64; 3],
-    ) -> Option<[f64; 2]> {
-        let (s, c) = pose[2].sin_cos();
-        project_with(&self.calibration(width_px, height_px), [pose[0], pose[1], c, s], world_m)
+    /// Where a world point appears for a robot at `pose`; `None` behind the camera.
+    pub fn project(&self, width_px: u32, height_px: u32, pose: Pose2, world_m: [f64; 3]) -> Option<[f64; 2]> {
+        let (s, c) = pose.heading_rad.sin_cos();
+        project_with(&self.calibration(width_px, height_px), [pose.x_m, pose.y_m, c, s], world_m)
     }
 }
 
@@ -46,24 +39,25 @@ pub fn project_with(m: &[[f64; 3]; 4], pose: [f64; 4], world_m: [f64; 3]) -> Opt
 
 #[cfg(test)]
 mod tests {
-    use crate::load_str;
+    use crate::{Pose2, load_str};
 
     #[test]
     fn points_project_through_the_calibration() {
         let w = load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads");
         let cam = &w.camera;
         // Straight ahead at camera height: the image centre.
-        assert_eq!(cam.project(640, 480, [0.0, 0.0, 0.0], [5.0, 0.0, cam.height_m]), Some([320.0, 240.0]));
+        assert_eq!(cam.project(640, 480, Pose2::default(), [5.0, 0.0, cam.height_m]), Some([320.0, 240.0]));
         // 1 m left at 2 m, on the floor: left of centre and below it, scaled by f / 2.
-        let [u, v] = cam.project(640, 480, [0.0, 0.0, 0.0], [2.0, 1.0, 0.0]).expect("in front");
+        let [u, v] = cam.project(640, 480, Pose2::default(), [2.0, 1.0, 0.0]).expect("in front");
         assert!((u - (320.0 - 554.0 / 2.0)).abs() < 1e-9 && (v - (240.0 + 554.0 * 1.2 / 2.0)).abs() < 1e-9);
         // Turning the robot left by 90 degrees brings a point on +y to the centre column.
-        let [u, _] =
-            cam.project(640, 480, [0.0, 0.0, std::f64::consts::FRAC_PI_2], [0.0, 3.0, 1.2]).expect("ahead");
+        let [u, _] = cam
+            .project(640, 480, Pose2::new(0.0, 0.0, std::f64::consts::FRAC_PI_2), [0.0, 3.0, 1.2])
+            .expect("ahead");
         assert!((u - 320.0).abs() < 1e-9);
-        assert!(cam.project(640, 480, [0.0, 0.0, 0.0], [-1.0, 0.0, 1.0]).is_none(), "behind");
+        assert!(cam.project(640, 480, Pose2::default(), [-1.0, 0.0, 1.0]).is_none(), "behind");
         // Half the width, half the focal length: the same ray lands on the same relative spot.
-        let [u2, _] = cam.project(320, 240, [0.0, 0.0, 0.0], [2.0, 1.0, 0.0]).expect("in front");
+        let [u2, _] = cam.project(320, 240, Pose2::default(), [2.0, 1.0, 0.0]).expect("in front");
         assert!((u2 - (160.0 - 277.0 / 2.0)).abs() < 1e-9);
     }
 }

@@ -3,6 +3,7 @@
 //!
 
 mod camera;
+mod check;
 mod load;
 mod model;
 mod movers;
@@ -11,10 +12,11 @@ mod raycast;
 pub mod topology;
 
 pub use camera::project_with;
+pub use check::Inconsistency;
 pub use load::{WorldError, load_str};
 pub use model::*;
 pub use movers::{Mover, load_movers, parse_movers};
-pub use poles::{Pole, PoleField};
+pub use poles::{Pole, PoleError, PoleField};
 pub use raycast::Hit;
 pub use topology::{Door, Landmark, LandmarkClass, Locale, Meadow, Strategy};
 

@@ -1,7 +1,8 @@
-//! Loading a world file: TOML parsing with errors that name file, line and field, then checks
-//! that the numbers make a world.
+//! Loading a world file: TOML parsing with errors that name file, line and field, then the
+//! checks (`check.rs`) that the numbers make a world.
 
 use crate::World;
+use crate::check::{Inconsistency, check};
 
 /// Why a world could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -10,8 +11,9 @@ pub enum WorldError {
     Io { file: String, detail: String },
     #[error("{file}:{line}: field `{field}`: {detail}")]
     Parse { file: String, line: usize, field: String, detail: String },
-    #[error("{file}: inconsistent world: {detail}")]
-    Inconsistent { file: String, detail: String },
+    /// Parsed, but the numbers make no world (or no mover): [`Inconsistency`] says why.
+    #[error("{file}: inconsistent world: {why}")]
+    Inconsistent { file: String, why: Inconsistency },
 }
 
 fn line_of(text: &str, offset: usize) -> usize {
@@ -27,118 +29,8 @@ pub fn load_str(text: &str, file: &str) -> Result<World, WorldError> {
         let line = inner.span().map_or(0, |s| line_of(text, s.start));
         WorldError::Parse { file: file.to_owned(), line, field, detail: inner.message().to_owned() }
     })?;
-    check(&world).map_err(|detail| WorldError::Inconsistent { file: file.to_owned(), detail })?;
+    check(&world).map_err(|why| WorldError::Inconsistent { file: file.to_owned(), why })?;
     Ok(world)
-}
-
-fn check(w: &World) -> Result<(), String> {
-    if !w.terrain.contains_key(&w.ground) {
-        return Err(format!("ground `{}` is not in the terrain table", w.ground));
-    }
-    if w.walls.is_empty() {
-        return Err("a world needs at least one wall".into());
-    }
-    for (i, wall) in w.walls.iter().enumerate() {
-        if !greater(wall.length_m(), 1e-6) || !greater(wall.height_m, 0.0) {
-            return Err(format!("wall[{i}] has no length or height"));
-        }
-        for (j, r) in wall.regions.iter().enumerate() {
-            if r.along_m[0] > r.along_m[1] || r.height_m[0] > r.height_m[1] {
-                return Err(format!("wall[{i}].region[{j}] has its bounds reversed"));
-            }
-        }
-    }
-    let c = &w.camera;
-    if c.width_px == 0 || c.height_px == 0 || !greater(c.focal_px, 0.0) || !greater(c.height_m, 0.0) {
-        return Err("camera needs a positive size, focal length and height".into());
-    }
-    let r = &w.robot;
-    if !greater(r.speed_mps, 0.0) || !greater(r.turn_rate_degps, 0.0) || !greater(r.sonar_max_range_ft, 0.0) {
-        return Err("robot speeds and sonar range must be positive".into());
-    }
-    if !greater(w.floor.tile_m, 0.0) {
-        return Err("floor tiles must have a positive size".into());
-    }
-    check_topology(w)
-}
-
-fn unique<'a>(what: &str, names: impl Iterator<Item = &'a str>) -> Result<(), String> {
-    let mut seen = std::collections::BTreeSet::new();
-    for n in names {
-        if !seen.insert(n) {
-            return Err(format!("two {what}s are named `{n}`"));
-        }
-    }
-    Ok(())
-}
-
-fn check_topology(w: &World) -> Result<(), String> {
-    unique("locale", w.locales.iter().map(|l| l.name.as_str()))?;
-    unique("meadow", w.meadows.iter().map(|m| m.name.as_str()))?;
-    unique("landmark", w.landmarks.iter().map(|l| l.name.as_str()))?;
-    let locale = |n: &str| w.locales.iter().find(|l| l.name == n);
-    for l in &w.locales {
-        let mut seen = vec![l.name.as_str()];
-        let mut parent = l.part_of.as_deref();
-        while let Some(p) = parent {
-            let up = locale(p).ok_or(format!("locale `{}` is part of missing locale `{p}`", l.name))?;
-            if seen.contains(&p) {
-                return Err(format!("locale `{}` is part of itself through {seen:?}", l.name));
-            }
-            seen.push(p);
-            parent = up.part_of.as_deref();
-        }
-        if !l.outline.is_empty() && l.outline.len() < 3 {
-            return Err(format!("locale `{}` has an outline of fewer than 3 points", l.name));
-        }
-    }
-    for (i, d) in w.doors.iter().enumerate() {
-        for n in &d.between {
-            if locale(n).is_none() {
-                return Err(format!("door[{i}] leads to missing locale `{n}`"));
-            }
-        }
-        if !greater(d.width_m, 0.0) {
-            return Err(format!("door[{i}] has no width"));
-        }
-    }
-    for m in &w.meadows {
-        if !w.terrain.contains_key(&m.terrain) {
-            return Err(format!(
-                "meadow `{}` has terrain `{}`, which is not in the terrain table",
-                m.name, m.terrain
-            ));
-        }
-        if m.outline.len() < 3 {
-            return Err(format!("meadow `{}` has an outline of fewer than 3 points", m.name));
-        }
-        if let Some(l) = m.landmarks.iter().find(|l| w.landmark(l).is_none()) {
-            return Err(format!("meadow `{}` lists missing landmark `{l}`", m.name));
-        }
-    }
-    for l in &w.landmarks {
-        if !w.meadows.iter().any(|m| m.landmarks.contains(&l.name)) {
-            return Err(format!("landmark `{}` lies outside every meadow (no meadow lists it)", l.name));
-        }
-        if !greater(l.activation_range_m, 0.0) {
-            return Err(format!("landmark `{}` has no activation range", l.name));
-        }
-        match l.class {
-            crate::LandmarkClass::I if !greater(l.height_m, 0.0) => {
-                return Err(format!("class I landmark `{}` needs a height_m", l.name));
-            }
-            crate::LandmarkClass::III if l.to_m.is_none() => {
-                return Err(format!("class III landmark `{}` needs a to_m end", l.name));
-            }
-            _ => {}
-        }
-    }
-    Ok(())
-}
-
-/// `v > min`, false for NaN: the check that a number is usable.
-fn greater(v: f64, min: f64) -> bool {
-    v > min
 }
 
 #[cfg(test)]

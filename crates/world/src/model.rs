@@ -1,5 +1,6 @@
 //! The world's data: what the file holds, in SI units.
 
+pub use harvey_geometry::Pose2;
 use serde::Deserialize;
 
 use crate::topology::{Door, Landmark, Locale, Meadow, contains, signed_area};
@@ -8,29 +9,19 @@ fn white() -> [f64; 3] {
     [1.0, 1.0, 1.0]
 }
 
-/// A planar pose in the world frame.
+/// The start pose as a world file gives it: `[start] x_m, y_m, heading_deg`.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Pose {
-    pub x_m: f64,
-    pub y_m: f64,
-    pub heading_deg: f64,
+struct StartPose {
+    x_m: f64,
+    y_m: f64,
+    heading_deg: f64,
 }
 
-impl std::str::FromStr for Pose {
-    type Err = String;
-
-    /// `x_m,y_m,heading_deg`, as a command line gives a start pose (`--start 5,4,-90`).
-    fn from_str(s: &str) -> Result<Self, Self::Err> {
-        let v: Vec<f64> = s
-            .split(',')
-            .map(|p| p.trim().parse::<f64>().map_err(|e| format!("pose `{s}`: `{p}`: {e}")))
-            .collect::<Result<_, _>>()?;
-        match v[..] {
-            [x_m, y_m, heading_deg] if v.iter().all(|c| c.is_finite()) => Ok(Pose { x_m, y_m, heading_deg }),
-            _ => Err(format!("pose `{s}`: want three finite numbers `x_m,y_m,heading_deg`")),
-        }
-    }
+/// Reads `[start]` (heading in degrees) into the one pose type.
+fn start_pose<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Pose2, D::Error> {
+    let p = StartPose::deserialize(d)?;
+    Ok(Pose2::from_degrees(p.x_m, p.y_m, p.heading_deg))
 }
 
 /// A rectangle on a wall with its own reflectance (a door, a sign, a baseboard).
@@ -147,7 +138,8 @@ pub struct World {
     pub name: String,
     /// The terrain the robot drives on, a key of `terrain`.
     pub ground: String,
-    pub start: Pose,
+    #[serde(deserialize_with = "start_pose")]
+    pub start: Pose2,
     pub robot: Robot,
     pub camera: Camera,
     pub floor: Floor,
@@ -233,15 +225,10 @@ impl World {
 
 #[cfg(test)]
 mod tests {
-    use super::Pose;
-
     #[test]
-    fn a_start_pose_is_read_from_the_command_line_form() {
-        let p: Pose = "5, 4.5,-90".parse().expect("parses");
-        assert_eq!(p, Pose { x_m: 5.0, y_m: 4.5, heading_deg: -90.0 });
-        let e = "5,4".parse::<Pose>().expect_err("two numbers");
-        assert!(e.contains("`5,4`") && e.contains("three finite numbers"), "{e}");
-        assert!("5,x,0".parse::<Pose>().expect_err("not a number").contains("`x`"));
-        assert!("5,4,inf".parse::<Pose>().is_err());
+    fn the_start_heading_is_read_in_degrees() {
+        // worlds/arena.toml: `[start] heading_deg = 45.0`.
+        let w = crate::load_str(include_str!("../../../worlds/arena.toml"), "arena.toml").expect("loads");
+        assert_eq!(w.start.heading_rad, 45f64.to_radians());
     }
 }

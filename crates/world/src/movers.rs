@@ -5,7 +5,7 @@
 
 use serde::Deserialize;
 
-use crate::{Wall, World, WorldError};
+use crate::{Inconsistency, Wall, World, WorldError};
 
 /// One moving thing.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -46,7 +46,7 @@ struct File {
 
 /// The `[[mover]]` tables of a launch file (other tables are other services' business).
 pub fn parse_movers(text: &str, file: &str) -> Result<Vec<Mover>, WorldError> {
-    let bad = |detail: String| WorldError::Inconsistent { file: file.to_owned(), detail };
+    let bad = |why: Inconsistency| WorldError::Inconsistent { file: file.to_owned(), why };
     let doc: toml::Table = toml::from_str(text)
         .map_err(|e| WorldError::Io { file: file.to_owned(), detail: e.message().to_owned() })?;
     let only: toml::Table = doc.into_iter().filter(|(k, _)| k == "mover").collect();
@@ -59,16 +59,13 @@ pub fn parse_movers(text: &str, file: &str) -> Result<Vec<Mover>, WorldError> {
     for m in &parsed.movers {
         let finite = m.outline.iter().flatten().chain(m.path.iter().flatten()).all(|v| v.is_finite());
         if m.outline.len() < 3 || m.path.is_empty() || !finite {
-            return Err(bad(format!(
-                "mover {}: needs 3 or more outline corners and a path of finite numbers",
-                m.name
-            )));
+            return Err(bad(Inconsistency::MoverShape { mover: m.name.clone() }));
         }
         if m.path.windows(2).any(|w| w[1][0] <= w[0][0]) {
-            return Err(bad(format!("mover {}: path times must increase", m.name)));
+            return Err(bad(Inconsistency::MoverTimes { mover: m.name.clone() }));
         }
         if m.height_m.is_nan() || m.height_m <= 0.0 || !(0.0..=1.0).contains(&m.reflectance) {
-            return Err(bad(format!("mover {}: height must be positive, reflectance in 0..=1", m.name)));
+            return Err(bad(Inconsistency::MoverLook { mover: m.name.clone() }));
         }
     }
     Ok(parsed.movers)

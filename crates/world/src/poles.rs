@@ -6,6 +6,8 @@
 
 use serde::Deserialize;
 
+use harvey_geometry::Rng;
+
 use crate::{Region, Wall, World};
 
 /// The `[poles]` table.
@@ -68,13 +70,12 @@ impl PoleField {
     }
 }
 
-/// splitmix64: a small seeded generator (the same seed puts the poles in the same places).
-fn next(state: &mut u64) -> f64 {
-    *state = state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-    let mut z = *state;
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    (z ^ (z >> 31)) as f64 / u64::MAX as f64
+/// Why the `[poles]` could not be put down.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PoleError {
+    /// 10 000 random places for pole `code` were all too near a wall, a pole or the start.
+    #[error("no room for pole {code} in {area_m:?} with {clearance_m} m clearance")]
+    NoRoom { code: u32, area_m: [[f64; 2]; 2], clearance_m: f64 },
 }
 
 /// Distance from `p` to the segment `a`-`b`.
@@ -87,9 +88,9 @@ fn to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 impl World {
     /// Puts the `[poles]` down for `seed` (none without the table) and returns them, code order.
     /// Call before adding movers: the poles are static walls.
-    pub fn place_poles(&mut self, seed: u64) -> Result<Vec<Pole>, String> {
+    pub fn place_poles(&mut self, seed: u64) -> Result<Vec<Pole>, PoleError> {
         let Some(f) = self.poles.clone() else { return Ok(Vec::new()) };
-        let mut state = seed ^ 0x5151_7e1e_c0de_0001;
+        let mut rng = Rng::new(seed ^ 0x5151_7e1e_c0de_0001);
         let mut placed: Vec<Pole> = Vec::new();
         let start = [self.start.x_m, self.start.y_m];
         for code in 0..f.count {
@@ -97,13 +98,10 @@ impl World {
             let at = loop {
                 tries += 1;
                 if tries > 10_000 {
-                    return Err(format!(
-                        "no room for pole {code} in {:?} with {} m clearance",
-                        f.area_m, f.clearance_m
-                    ));
+                    return Err(PoleError::NoRoom { code, area_m: f.area_m, clearance_m: f.clearance_m });
                 }
                 let [[x0, y0], [x1, y1]] = f.area_m;
-                let p = [x0 + (x1 - x0) * next(&mut state), y0 + (y1 - y0) * next(&mut state)];
+                let p = [x0 + (x1 - x0) * rng.unit(), y0 + (y1 - y0) * rng.unit()];
                 let clear = self.walls.iter().all(|w| to_segment(p, w.from, w.to) >= f.clearance_m)
                     && placed.iter().all(|q| (q.at[0] - p[0]).hypot(q.at[1] - p[1]) >= f.clearance_m)
                     && (start[0] - p[0]).hypot(start[1] - p[1]) >= f.clearance_m;
@@ -176,6 +174,18 @@ mod tests {
             assert_eq!(f.code_at(f.code_height_m(k) + 0.3 * f.code_step_m), Some(k));
         }
         assert_eq!(f.code_at(f.code_height_m(9) + f.code_step_m), None);
+    }
+
+    #[test]
+    fn a_field_too_small_for_its_poles_says_so() {
+        let mut w = crate::load_str(include_str!("../../../worlds/arena.toml"), "arena.toml").expect("loads");
+        let f = w.poles.as_mut().expect("a [poles] table");
+        let [[x0, y0], _] = f.area_m;
+        f.area_m[1] = [x0 + 0.01, y0 + 0.01];
+        let e = w.place_poles(1).expect_err("no room for two poles in a square centimetre");
+        assert!(matches!(e, super::PoleError::NoRoom { .. }), "{e:?}");
+        let text = e.to_string();
+        assert!(text.starts_with("no room for pole ") && text.ends_with(" m clearance"), "{text}");
     }
 
     #[test]

@@ -4,7 +4,7 @@
 use harvey_drv_protocol::{Command, NakReason, Report};
 use harvey_msgs::{CommandKind, EncodersRaw, Header, MotionCommand, SonarRaw};
 
-const FT: f64 = 0.3048;
+use harvey_geometry::FT;
 /// Longest MOVE the bridge sends: the DRV's limit, in feet.
 pub const MAX_MOVE_FT: f64 = 100.0;
 /// Largest TURN the bridge sends, in degrees.

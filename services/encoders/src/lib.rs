@@ -2,7 +2,17 @@
 //! carries the commanded motion and the progress made on it, for the UMS's growth and the
 //! executive's monitoring.
 
+use harvey_geometry::wrap;
 use harvey_msgs::{EncodersRaw, Header, MotionCommand, Odometry, Pose2};
+
+/// Why an encoder report was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum EncoderError {
+    #[error("encoder report at {stamp_ns} ns is older than the last ({last_ns} ns)")]
+    OutOfOrder { stamp_ns: u64, last_ns: u64 },
+    #[error("encoder report holds a non-finite number")]
+    NotFinite,
+}
 
 /// Odometry state: the last command and where the encoders stood when the DRV accepted it.
 #[derive(Debug, Default)]
@@ -16,10 +26,6 @@ pub struct OdometryBuilder {
     last_stamp_ns: u64,
 }
 
-fn wrap_pi(a: f64) -> f64 {
-    (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
-}
-
 impl OdometryBuilder {
     /// A command sent to the vehicle (panic stops included).
     pub fn on_command(&mut self, cmd: &MotionCommand) {
@@ -28,15 +34,15 @@ impl OdometryBuilder {
     }
 
     /// One encoder report; reports older than the last are refused.
-    pub fn on_encoders(&mut self, e: &EncodersRaw) -> Result<Odometry, String> {
+    pub fn on_encoders(&mut self, e: &EncodersRaw) -> Result<Odometry, EncoderError> {
         if e.header.stamp_ns < self.last_stamp_ns {
-            return Err(format!(
-                "encoder report at {} ns is older than the last ({} ns)",
-                e.header.stamp_ns, self.last_stamp_ns
-            ));
+            return Err(EncoderError::OutOfOrder {
+                stamp_ns: e.header.stamp_ns,
+                last_ns: self.last_stamp_ns,
+            });
         }
         if !(e.x_m.is_finite() && e.y_m.is_finite() && e.heading_rad.is_finite()) {
-            return Err("encoder report holds a non-finite number".into());
+            return Err(EncoderError::NotFinite);
         }
         self.last_stamp_ns = e.header.stamp_ns;
         let pose = Pose2 { x_m: e.x_m, y_m: e.y_m, heading_rad: e.heading_rad };
@@ -48,9 +54,7 @@ impl OdometryBuilder {
         }
         self.previous = Some(pose);
         let (travelled_m, turned_rad) = match self.start {
-            Some(s) => {
-                ((pose.x_m - s.x_m).hypot(pose.y_m - s.y_m), wrap_pi(pose.heading_rad - s.heading_rad))
-            }
+            Some(s) => ((pose.x_m - s.x_m).hypot(pose.y_m - s.y_m), wrap(pose.heading_rad - s.heading_rad)),
             None => (0.0, 0.0),
         };
         self.seq += 1;
@@ -103,7 +107,9 @@ mod tests {
         o.on_encoders(&enc(10, 0.0, 6.2, 1, 1)).expect("ok");
         let t = o.on_encoders(&enc(20, 0.0, 0.1, 1, 0)).expect("ok");
         assert!((t.turned_rad - (0.1 + std::f64::consts::TAU - 6.2)).abs() < 1e-9, "{}", t.turned_rad);
-        assert!(o.on_encoders(&enc(5, 0.0, 0.0, 1, 0)).is_err(), "out of order");
-        assert!(o.on_encoders(&enc(30, f64::NAN, 0.0, 1, 0)).is_err(), "NaN");
+        let e = o.on_encoders(&enc(5, 0.0, 0.0, 1, 0)).expect_err("out of order");
+        assert_eq!(e.to_string(), "encoder report at 5 ns is older than the last (20 ns)");
+        let e = o.on_encoders(&enc(30, f64::NAN, 0.0, 1, 0)).expect_err("NaN");
+        assert_eq!(e.to_string(), "encoder report holds a non-finite number");
     }
 }

@@ -5,14 +5,13 @@
 //! `main.rs` puts it on a pseudo-terminal and paces it; nothing here reads a clock.
 
 pub mod motion;
-pub mod rng;
 pub mod sonar;
 
 use harvey_drv_protocol::{Command, NakReason, Report};
 use harvey_world::World;
 
-use motion::{FT, Motion, Pose};
-use rng::Rng;
+use harvey_geometry::Rng;
+use motion::{FT, Motion, Pose2};
 
 /// Longest MOVE the DRV accepts, in feet.
 pub const MAX_MOVE_FT: f64 = 100.0;
@@ -23,7 +22,7 @@ pub const MAX_TURN_DEG: f64 = 360.0;
 #[derive(Debug, Clone, PartialEq)]
 pub struct TickOutput {
     pub time_ms: u64,
-    pub truth: Pose,
+    pub truth: Pose2,
     pub reports: Vec<Report>,
 }
 
@@ -33,8 +32,8 @@ pub struct SimDrv {
     tick_ms: u64,
     rng: Rng,
     time_ms: u64,
-    truth: Pose,
-    encoders: Pose,
+    truth: Pose2,
+    encoders: Pose2,
     motion: Option<Motion>,
     last_command: u32,
     next_bank: u8,
@@ -46,8 +45,7 @@ impl SimDrv {
     pub fn new(world: World, tick_ms: u64, seed: u64) -> Self {
         let mut rng = Rng::new(seed);
         let drift_sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
-        let s = world.start;
-        let truth = Pose { x: s.x_m, y: s.y_m, th: s.heading_deg.to_radians() };
+        let truth = world.start;
         Self {
             world,
             tick_ms,
@@ -62,7 +60,7 @@ impl SimDrv {
         }
     }
 
-    pub fn truth(&self) -> Pose {
+    pub fn truth(&self) -> Pose2 {
         self.truth
     }
 
@@ -77,7 +75,7 @@ impl SimDrv {
     /// Accepts or refuses a command; the answer goes back on the line at once.
     pub fn handle(&mut self, cmd: Command) -> Report {
         // The terrain under the robot when the command starts (its meadow's, 002 §4).
-        let t = self.world.terrain_at(self.truth.x, self.truth.y).clone();
+        let t = self.world.terrain_at(self.truth.x_m, self.truth.y_m).clone();
         let r = self.world.robot.clone();
         let (id, motion) = match cmd {
             Command::Stop { id } => {
@@ -149,7 +147,7 @@ impl SimDrv {
         self.world.set_time(self.time_ms as f64 / 1000.0);
         let dt_s = self.tick_ms as f64 / 1000.0;
         if let Some(m) = &mut self.motion {
-            let t = self.world.terrain_at(self.truth.x, self.truth.y);
+            let t = self.world.terrain_at(self.truth.x_m, self.truth.y_m);
             let (truth, enc, finished) = motion::advance(m, t, self.truth, self.encoders, dt_s);
             self.truth = truth;
             self.encoders = enc;
@@ -160,12 +158,12 @@ impl SimDrv {
         let bank = self.next_bank;
         self.next_bank = (bank + 1) % 3;
         let ranges_tenths_ft = sonar::fire_bank(&self.world, self.truth, bank);
-        let heading_deg = self.encoders.th.to_degrees().rem_euclid(360.0);
+        let heading_deg = self.encoders.heading_rad.to_degrees().rem_euclid(360.0);
         let reports = vec![
             Report::Encoders {
                 time_ms: self.time_ms,
-                x_hundredths_ft: (self.encoders.x / FT * 100.0).round() as i32,
-                y_hundredths_ft: (self.encoders.y / FT * 100.0).round() as i32,
+                x_hundredths_ft: (self.encoders.x_m / FT * 100.0).round() as i32,
+                y_hundredths_ft: (self.encoders.y_m / FT * 100.0).round() as i32,
                 heading_tenths_deg: ((heading_deg * 10.0).round() as i32) % 3600,
                 moving: self.motion.is_some(),
                 command_id: self.last_command,
@@ -207,7 +205,7 @@ mod tests {
             panic!("{out:?}")
         };
         assert_eq!((x_hundredths_ft, moving, command_id), (1000, false, 1));
-        let true_ft = out.truth.x / FT;
+        let true_ft = out.truth.x_m / FT;
         assert!(true_ft < 10.0 && true_ft > 9.4, "{true_ft}");
     }
 

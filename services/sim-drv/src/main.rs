@@ -10,7 +10,7 @@ use clap::Parser;
 use harvey_bus::{Bus, FdSource, Waiter, Wake};
 use harvey_drv_protocol::serial::{make_raw, read_available, set_nonblocking, write_frame};
 use harvey_drv_protocol::{Decoder, Line, encode};
-use harvey_msgs::{Header, Pose2, TruePose, topics};
+use harvey_msgs::{Header, TruePose, topics};
 use harvey_sim_drv::SimDrv;
 
 #[derive(Parser)]
@@ -34,7 +34,7 @@ struct Args {
     /// Where the robot starts, `x_m,y_m,heading_deg`, instead of the world's `[start]` (a
     /// mission's own start).
     #[arg(long)]
-    start: Option<harvey_world::Pose>,
+    start: Option<harvey_world::Pose2>,
     /// A launch file whose `[[mover]]` tables put moving things in the world.
     #[arg(long)]
     movers: Option<PathBuf>,
@@ -48,7 +48,7 @@ fn main() -> anyhow::Result<()> {
     if let Some(start) = args.start {
         world.start = start;
     }
-    for p in world.place_poles(args.seed).map_err(anyhow::Error::msg)? {
+    for p in world.place_poles(args.seed)? {
         tracing::info!(code = p.code, x_m = p.at[0], y_m = p.at[1], "pole placed");
     }
     if let Some(file) = &args.movers {
@@ -137,7 +137,7 @@ fn tick(
 ) -> anyhow::Result<()> {
     let out = sim.tick();
     let stamp_ns = out.time_ms * 1_000_000;
-    let pose = Pose2 { x_m: out.truth.x, y_m: out.truth.y, heading_rad: out.truth.th };
+    let pose = out.truth;
     truth_pub.send(&TruePose {
         header: Header::new(stamp_ns / (tick_ms * 1_000_000), stamp_ns),
         world_from_robot: pose,

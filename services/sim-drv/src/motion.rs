@@ -4,45 +4,16 @@
 
 use harvey_world::Terrain;
 
-use crate::rng::Rng;
+use harvey_geometry::Rng;
 
-pub const FT: f64 = 0.3048;
-
-/// A planar pose, SI.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Pose {
-    pub x: f64,
-    pub y: f64,
-    pub th: f64,
-}
-
-impl Pose {
-    /// The pose reached by driving `s` metres from here while the heading changes linearly by
-    /// `dth` over the way (an arc; a straight line when `dth` is 0).
-    pub fn arc(&self, s: f64, dth: f64) -> Pose {
-        if dth.abs() < 1e-9 {
-            return Pose { x: self.x + s * self.th.cos(), y: self.y + s * self.th.sin(), th: self.th };
-        }
-        let r = s / dth;
-        Pose {
-            x: self.x + r * ((self.th + dth).sin() - self.th.sin()),
-            y: self.y - r * ((self.th + dth).cos() - self.th.cos()),
-            th: self.th + dth,
-        }
-    }
-
-    /// Shifted sideways by `d` metres (positive: to the left of the heading).
-    pub fn sideways(&self, d: f64) -> Pose {
-        Pose { x: self.x - d * self.th.sin(), y: self.y + d * self.th.cos(), th: self.th }
-    }
-}
+pub use harvey_geometry::{FT, Pose2};
 
 /// A motion under way: where it started, where it will end (true and encoder), how far along.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Motion {
     Move {
-        truth0: Pose,
-        enc0: Pose,
+        truth0: Pose2,
+        enc0: Pose2,
         true_m: f64,
         true_dth: f64,
         commanded_m: f64,
@@ -50,8 +21,8 @@ pub enum Motion {
         duration_s: f64,
     },
     Turn {
-        truth0: Pose,
-        enc0: Pose,
+        truth0: Pose2,
+        enc0: Pose2,
         true_rad: f64,
         skitter_m: f64,
         commanded_rad: f64,
@@ -71,8 +42,8 @@ pub fn plan_move(
     t: &Terrain,
     rng: &mut Rng,
     drift_sign: f64,
-    truth0: Pose,
-    enc0: Pose,
+    truth0: Pose2,
+    enc0: Pose2,
     commanded_m: f64,
     speed_mps: f64,
 ) -> Motion {
@@ -97,8 +68,8 @@ pub fn plan_move(
 pub fn plan_turn(
     t: &Terrain,
     rng: &mut Rng,
-    truth0: Pose,
-    enc0: Pose,
+    truth0: Pose2,
+    enc0: Pose2,
     commanded_rad: f64,
     rate_radps: f64,
 ) -> Motion {
@@ -119,7 +90,7 @@ pub fn plan_turn(
 }
 
 /// Advances a motion by `dt_s`; returns the new (truth, encoder) poses and whether it finished.
-pub fn advance(m: &mut Motion, t: &Terrain, truth: Pose, enc: Pose, dt_s: f64) -> (Pose, Pose, bool) {
+pub fn advance(m: &mut Motion, t: &Terrain, truth: Pose2, enc: Pose2, dt_s: f64) -> (Pose2, Pose2, bool) {
     match m {
         Motion::Move { truth0, enc0, true_m, true_dth, commanded_m, done, duration_s } => {
             *done = if *duration_s > 0.0 { (*done + dt_s / *duration_s).min(1.0) } else { 1.0 };
@@ -130,8 +101,8 @@ pub fn advance(m: &mut Motion, t: &Terrain, truth: Pose, enc: Pose, dt_s: f64) -
             *done = if *duration_s > 0.0 { (*done + dt_s / *duration_s).min(1.0) } else { 1.0 };
             let f = *done;
             let shifted = truth0.sideways(f * *skitter_m);
-            let truth = Pose { th: truth0.th + f * *true_rad, ..shifted };
-            (truth, Pose { th: enc0.th + f * *commanded_rad, ..*enc0 }, f >= 1.0)
+            let truth = Pose2 { heading_rad: truth0.heading_rad + f * *true_rad, ..shifted };
+            (truth, Pose2 { heading_rad: enc0.heading_rad + f * *commanded_rad, ..*enc0 }, f >= 1.0)
         }
         Motion::Velocity { v_mps, w_radps, drift_rad_per_m } => {
             let s_true = *v_mps * (1.0 - t.translational_loss_ft_per_ft) * dt_s;
@@ -159,11 +130,11 @@ mod tests {
         let n = 2000;
         let mut travelled_ft = Vec::new();
         for _ in 0..n {
-            let mut m = plan_move(&tile(), &mut rng, 1.0, Pose::default(), Pose::default(), 20.0 * FT, 0.3);
-            let (truth, enc, finished) = advance(&mut m, &tile(), Pose::default(), Pose::default(), 1e6);
+            let mut m = plan_move(&tile(), &mut rng, 1.0, Pose2::default(), Pose2::default(), 20.0 * FT, 0.3);
+            let (truth, enc, finished) = advance(&mut m, &tile(), Pose2::default(), Pose2::default(), 1e6);
             assert!(finished);
-            assert!((enc.x - 20.0 * FT).abs() < 1e-9, "encoders report the commanded move");
-            let d = truth.x.hypot(truth.y) / FT;
+            assert!((enc.x_m - 20.0 * FT).abs() < 1e-9, "encoders report the commanded move");
+            let d = truth.x_m.hypot(truth.y_m) / FT;
             assert!(d <= 20.0 + 1e-9, "never further than commanded: {d}");
             travelled_ft.push(d);
         }
@@ -171,16 +142,5 @@ mod tests {
         // 20 ft at 4.2 % loss plus 0.0084 ft inertial loss; the arc's chord is a hair shorter.
         let expected = 20.0 - 20.0 * 0.042 - 0.0084;
         assert!((mean - expected).abs() < 0.01, "mean {mean} vs {expected}");
-    }
-
-    #[test]
-    fn arcs_and_turns_compose() {
-        let p = Pose { x: 1.0, y: 2.0, th: 0.5 };
-        let q = p.arc(3.0, 0.0);
-        assert!((q.x - (1.0 + 3.0 * 0.5f64.cos())).abs() < 1e-12);
-        let r = p.arc(1e-3, 1e-12);
-        assert!((r.x - p.arc(1e-3, 0.0).x).abs() < 1e-9);
-        let s = Pose::default().sideways(1.0);
-        assert!((s.y - 1.0).abs() < 1e-12 && s.x.abs() < 1e-12);
     }
 }

@@ -5,7 +5,7 @@
 use harvey_drv_protocol::SONAR_NO_ECHO;
 use harvey_world::World;
 
-use crate::motion::{FT, Pose};
+use crate::motion::{FT, Pose2};
 
 /// Rays cast across one beam.
 const RAYS_PER_BEAM: usize = 9;
@@ -16,10 +16,11 @@ pub fn bearing_rad(i: usize) -> f64 {
 }
 
 /// Range of one sensor in tenths of a foot from the sensor face, or [`SONAR_NO_ECHO`].
-pub fn read_sensor(world: &World, truth: Pose, i: usize) -> u16 {
+pub fn read_sensor(world: &World, truth: Pose2, i: usize) -> u16 {
     let r = &world.robot;
-    let axis = truth.th + bearing_rad(i);
-    let origin = [truth.x + r.sonar_ring_radius_m * axis.cos(), truth.y + r.sonar_ring_radius_m * axis.sin()];
+    let axis = truth.heading_rad + bearing_rad(i);
+    let origin =
+        [truth.x_m + r.sonar_ring_radius_m * axis.cos(), truth.y_m + r.sonar_ring_radius_m * axis.sin()];
     let half = (r.sonar_beam_width_deg / 2.0).to_radians();
     let limit = r.sonar_specular_limit_deg.to_radians();
     let max_m = r.sonar_max_range_ft * FT;
@@ -59,7 +60,7 @@ pub fn read_sensor(world: &World, truth: Pose, i: usize) -> u16 {
 }
 
 /// Fires bank `bank` (0..3): sensors `bank`, `bank + 3`, ... `bank + 21`.
-pub fn fire_bank(world: &World, truth: Pose, bank: u8) -> [u16; 8] {
+pub fn fire_bank(world: &World, truth: Pose2, bank: u8) -> [u16; 8] {
     std::array::from_fn(|k| read_sensor(world, truth, bank as usize + 3 * k))
 }
 
@@ -75,12 +76,12 @@ mod tests {
     fn a_wall_abeam_reads_its_distance_to_a_tenth_of_a_foot() {
         let w = hallway();
         // Robot on the centre line facing +x: sensor 6 (90 degrees) faces the left wall 1 m away.
-        let truth = Pose { x: 2.0, y: 0.0, th: 0.0 };
+        let truth = Pose2 { x_m: 2.0, y_m: 0.0, heading_rad: 0.0 };
         let expected = ((1.0 - w.robot.sonar_ring_radius_m) / FT * 10.0).round() as u16;
         assert_eq!(read_sensor(&w, truth, 6), expected, "exact to the tenth of a foot");
         // Any angle inside the beam: the nearest echo is still the perpendicular one.
         for th in [-0.25f64, -0.1, 0.07, 0.25] {
-            let turned = Pose { th, ..truth };
+            let turned = Pose2 { heading_rad: th, ..truth };
             let d =
                 (1.0 - w.robot.sonar_ring_radius_m * (std::f64::consts::FRAC_PI_2 + th).sin()) / FT * 10.0;
             assert_eq!(read_sensor(&w, turned, 6), d.round() as u16, "robot turned {th} rad");
@@ -93,7 +94,7 @@ mod tests {
         // Facing along the corridor from its far end region, sensor 0 looks 17 m down the hall
         // at the end wall head-on, but sensor 1 (15 degrees) with the robot hugging the wall sees
         // the side wall only at grazing incidence.
-        let truth = Pose { x: 0.0, y: 0.75, th: 0.0 };
+        let truth = Pose2 { x_m: 0.0, y_m: 0.75, heading_rad: 0.0 };
         assert_eq!(read_sensor(&w, truth, 1), SONAR_NO_ECHO);
     }
 }

@@ -2,10 +2,11 @@
 //! and 1000 seeded TURNs on each terrain, the measured means and standard deviations of
 //! translational loss, drift, rotational loss and skitter match the table within sampling
 //! tolerance. The vehicle never goes further than commanded.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use harvey_drv_protocol::Command;
 use harvey_sim_drv::SimDrv;
-use harvey_sim_drv::motion::{FT, Pose};
+use harvey_sim_drv::motion::{FT, Pose2};
 use harvey_world::{Terrain, World};
 
 const RUNS: u64 = 1000;
@@ -19,7 +20,7 @@ fn campus_on(terrain: &str) -> World {
     w
 }
 
-fn run(world: &World, seed: u64, cmd: Command) -> Pose {
+fn run(world: &World, seed: u64, cmd: Command) -> Pose2 {
     let mut sim = SimDrv::new(world.clone(), 1000, seed);
     sim.handle(cmd);
     for _ in 0..1000 {
@@ -52,8 +53,8 @@ fn moves(t: &Terrain, world: &World, name: &str) {
     let (mut loss, mut drift) = (Vec::new(), Vec::new());
     for seed in 0..RUNS {
         let p = run(world, seed, Command::Move { id: 1, hundredths_ft: (ft * 100.0) as i32 });
-        let chord_ft = (p.x - world.start.x_m).hypot(p.y - world.start.y_m) / FT;
-        let th = p.th.abs();
+        let chord_ft = (p.x_m - world.start.x_m).hypot(p.y_m - world.start.y_m) / FT;
+        let th = p.heading_rad.abs();
         // Arc length from the chord and the heading change the drift made.
         let arc_ft = if th > 1e-12 { chord_ft * (th / 2.0) / (th / 2.0).sin() } else { chord_ft };
         assert!(arc_ft <= ft + 1e-9, "{name}: seed {seed} went {arc_ft} ft for {ft}");
@@ -75,10 +76,10 @@ fn turns(t: &Terrain, world: &World, name: &str) {
     let (mut loss, mut skitter) = (Vec::new(), Vec::new());
     for seed in 0..RUNS {
         let p = run(world, seed, Command::Turn { id: 1, tenths_deg: (deg * 10.0) as i32 });
-        let turned = p.th.to_degrees();
+        let turned = p.heading_rad.to_degrees();
         assert!((0.0..=deg).contains(&turned), "{name}: seed {seed} turned {turned} for {deg}");
         loss.push((deg - turned) / deg);
-        skitter.push((p.x - world.start.x_m).hypot(p.y - world.start.y_m) / FT / deg);
+        skitter.push((p.x_m - world.start.x_m).hypot(p.y_m - world.start.y_m) / FT / deg);
     }
     check(
         &format!("{name} rotational loss (deg/deg)"),

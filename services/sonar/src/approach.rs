@@ -12,7 +12,7 @@
 
 use std::collections::VecDeque;
 
-use harvey_msgs::{Odometry, SONAR_SENSORS, SonarRing};
+use harvey_msgs::{Odometry, Pose2, SONAR_SENSORS, SonarRing};
 
 use crate::bearing_rad;
 
@@ -100,7 +100,7 @@ impl Window {
 #[derive(Debug)]
 pub struct Approach {
     p: ApproachParams,
-    poses: VecDeque<(u64, [f64; 3])>,
+    poses: VecDeque<(u64, Pose2)>,
     windows: [Window; SONAR_SENSORS],
 }
 
@@ -117,12 +117,12 @@ impl Approach {
         if self.poses.len() == POSES {
             self.poses.pop_front();
         }
-        self.poses.push_back((t, [w.x_m, w.y_m, w.heading_rad]));
+        self.poses.push_back((t, w));
     }
 
-    /// The robot's pose (x, y, heading) at `t`: interpolated between odometry poses, extrapolated
-    /// from the last two past the newest.
-    fn pose_at(&self, t: u64) -> Option<[f64; 3]> {
+    /// The robot's pose at `t`: interpolated between odometry poses, extrapolated from the last
+    /// two past the newest.
+    fn pose_at(&self, t: u64) -> Option<Pose2> {
         let n = self.poses.len();
         let first = self.poses.front()?;
         if n == 1 || t <= first.0 {
@@ -131,7 +131,11 @@ impl Approach {
         let k = self.poses.iter().position(|&(s, _)| s >= t).unwrap_or(n - 1).max(1);
         let ((t0, a), (t1, b)) = (self.poses[k - 1], self.poses[k]);
         let f = (t as f64 - t0 as f64) / (t1 as f64 - t0 as f64);
-        Some([0, 1, 2].map(|i| a[i] + f * (b[i] - a[i])))
+        Some(Pose2 {
+            x_m: a.x_m + f * (b.x_m - a.x_m),
+            y_m: a.y_m + f * (b.y_m - a.y_m),
+            heading_rad: a.heading_rad + f * (b.heading_rad - a.heading_rad),
+        })
     }
 
     /// The robot's velocity (world frame, m/s) from its two newest poses.
@@ -142,7 +146,7 @@ impl Approach {
         }
         let ((t0, a), (t1, b)) = (self.poses[n - 2], self.poses[n - 1]);
         let dt = (t1 - t0) as f64 * 1e-9;
-        [(b[0] - a[0]) / dt, (b[1] - a[1]) / dt]
+        [(b.x_m - a.x_m) / dt, (b.y_m - a.y_m) / dt]
     }
 
     /// Folds in a ring's new readings; returns the mask of sensors whose latest reading showed
@@ -154,7 +158,7 @@ impl Approach {
         for i in 0..SONAR_SENSORS {
             let (r, stamp) = (ring.range_m[i], ring.reading_stamp_ns[i]);
             let valid = ring.valid_mask & (1 << i) != 0 && r.is_finite();
-            let Some([x, y, th]) = self.pose_at(stamp) else { continue };
+            let Some(Pose2 { x_m: x, y_m: y, heading_rad: th }) = self.pose_at(stamp) else { continue };
             let w = &mut self.windows[i];
             if !valid {
                 *w = Window::default();

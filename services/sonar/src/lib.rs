@@ -16,6 +16,14 @@ pub fn bearing_rad(i: usize) -> f64 {
     i as f64 * std::f64::consts::TAU / SONAR_SENSORS as f64
 }
 
+/// Why a bank of readings was refused.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum BankError {
+    /// The DRV fires banks 0, 1 and 2 only.
+    #[error("sonar bank {bank} does not exist (0..=2)")]
+    NoSuchBank { bank: u32 },
+}
+
 /// What one bank of readings produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Update {
@@ -44,9 +52,9 @@ impl SonarRingBuilder {
     }
 
     /// Folds in one bank; rejects a bank number the DRV cannot send.
-    pub fn on_bank(&mut self, raw: &SonarRaw) -> Result<Update, String> {
+    pub fn on_bank(&mut self, raw: &SonarRaw) -> Result<Update, BankError> {
         if raw.bank >= 3 {
-            return Err(format!("sonar bank {} does not exist (0..=2)", raw.bank));
+            return Err(BankError::NoSuchBank { bank: raw.bank });
         }
         for k in 0..SONAR_BANK_SIZE {
             let i = raw.bank as usize + 3 * k;
@@ -107,7 +115,8 @@ mod tests {
         assert_eq!(u.ring.reading_stamp_ns[23], 30);
         assert_eq!(u.ring.valid_mask, (1 << 24) - 1);
         assert!((f64::from(u.ring.bearing_rad[6]) - std::f64::consts::FRAC_PI_2).abs() < 1e-6);
-        assert!(b.on_bank(&bank(3, [1.0; 8], 40)).is_err());
+        let e = b.on_bank(&bank(3, [1.0; 8], 40)).expect_err("no bank 3");
+        assert_eq!(e.to_string(), "sonar bank 3 does not exist (0..=2)");
     }
 
     #[test]

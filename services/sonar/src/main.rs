@@ -46,7 +46,7 @@ fn main() -> anyhow::Result<()> {
     let _a = pace.attach(&waiter, &[&raw, &odometry])?;
     harvey_runtime::notify_ready()?;
 
-    const FT: f64 = 0.3048;
+    use harvey_geometry::FT;
     let mut ring = SonarRingBuilder::new(args.panic_stop_ft * FT);
     let mut avoid = (args.avoid_dash_ft > 0.0).then(|| {
         PanicAvoid::new(AvoidParams {

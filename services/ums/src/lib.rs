@@ -5,6 +5,7 @@
 //! fixes (000 §5.6) shrink it to a small region, and the map reports "lost" when it grows too
 //! large or predicted landmarks go missing.
 
+mod error;
 pub mod expecter;
 mod fix;
 pub mod geometry;
@@ -19,6 +20,7 @@ use harvey_msgs::{
 };
 use harvey_world::{LandmarkClass, Strategy, World};
 
+pub use error::{FixError, OdometryError, SightingError};
 use expecter::View;
 use map::{Growth, Map};
 use reduction::{Known, Observation};
@@ -65,7 +67,7 @@ pub enum Output {
     Expectation(Expectation),
     /// A sighting that fell due could not be applied (why, naming it); the map and the
     /// expectations of the same odometry go out all the same.
-    Rejected(String),
+    Rejected(SightingError),
 }
 
 /// The UMS's state.
@@ -91,7 +93,7 @@ impl Ums {
     /// Starts with the pose known exactly at the world's start.
     pub fn new(world: World, config: Config) -> Self {
         let s = world.start;
-        let map = Map::exact(s.x_m, s.y_m, s.heading_deg.to_radians());
+        let map = Map::exact(s.x_m, s.y_m, s.heading_rad);
         Self {
             world,
             config,
@@ -123,15 +125,15 @@ impl Ums {
     }
 
     /// One odometry message: grow by the motion since the last, apply sightings now due.
-    pub fn on_odometry(&mut self, o: &Odometry) -> Result<Vec<Output>, String> {
+    pub fn on_odometry(&mut self, o: &Odometry) -> Result<Vec<Output>, OdometryError> {
         if o.header.stamp_ns < self.last_stamp_ns {
-            return Err(format!(
-                "odometry at {} ns is older than the last ({} ns)",
-                o.header.stamp_ns, self.last_stamp_ns
-            ));
+            return Err(OdometryError::OutOfOrder {
+                stamp_ns: o.header.stamp_ns,
+                last_ns: self.last_stamp_ns,
+            });
         }
         if !(o.travelled_m.is_finite() && o.turned_rad.is_finite() && o.command.distance_m.is_finite()) {
-            return Err("odometry holds a non-finite number".into());
+            return Err(OdometryError::NotFinite);
         }
         self.last_stamp_ns = o.header.stamp_ns;
         if o.command_accepted == 1 && o.command.command_id != self.command_id {
@@ -170,7 +172,7 @@ impl Ums {
     }
 
     /// A sighting: checked, then applied at its stamp once odometry has reached it.
-    pub fn on_sighting(&mut self, s: &LandmarkSighting) -> Result<(), String> {
+    pub fn on_sighting(&mut self, s: &LandmarkSighting) -> Result<(), SightingError> {
         self.check_sighting(s)?;
         if s.header.stamp_ns > self.last_stamp_ns {
             self.pending.push(*s);
@@ -179,20 +181,19 @@ impl Ums {
         self.apply_sighting(s)
     }
 
-    fn check_sighting(&self, s: &LandmarkSighting) -> Result<(), String> {
+    fn check_sighting(&self, s: &LandmarkSighting) -> Result<(), SightingError> {
         let name = self.world.landmarks.get(s.landmark_index as usize).map(|l| l.name.as_str());
-        let name =
-            name.ok_or(format!("sighting of landmark #{} which is not in the world", s.landmark_index))?;
+        let name = name.ok_or(SightingError::UnknownLandmark { index: s.landmark_index })?;
         if SightingKind::from_raw(s.kind).is_none() {
-            return Err(format!("sighting of `{name}` has unknown kind {}", s.kind));
+            return Err(SightingError::UnknownKind { landmark: name.to_owned(), kind: s.kind });
         }
         if ![s.a, s.a_sd, s.b, s.b_sd].iter().all(|v| v.is_finite()) {
-            return Err(format!("sighting of `{name}` holds a non-finite number"));
+            return Err(SightingError::NotFinite { landmark: name.to_owned() });
         }
         Ok(())
     }
 
-    fn apply_sighting(&mut self, s: &LandmarkSighting) -> Result<(), String> {
+    fn apply_sighting(&mut self, s: &LandmarkSighting) -> Result<(), SightingError> {
         let l = &self.world.landmarks[s.landmark_index as usize];
         let obs = match SightingKind::from_raw(s.kind) {
             Some(SightingKind::NotFound) | None => {
@@ -218,24 +219,27 @@ impl Ums {
             to: l.to_m.map(|t| [t[0], t[1]]),
             position_sd_m: l.position_sd_m,
         };
-        let (sigmas, name) = (self.config.sigmas, l.name.clone());
-        self.rewrite_at(s.header.stamp_ns, &format!("sighting of `{name}`"), |then| {
-            reduction::apply(then, &known, &obs, sigmas).map_err(|e| format!("sighting of `{name}`: {e}"))
-        })
+        let (sigmas, name, stamp_ns) = (self.config.sigmas, l.name.clone(), s.header.stamp_ns);
+        self.rewrite_at(
+            stamp_ns,
+            || SightingError::TooOld { landmark: name.clone(), stamp_ns },
+            |then| {
+                reduction::apply(then, &known, &obs, sigmas)
+                    .map_err(|why| SightingError::Rejected { landmark: name.clone(), why })
+            },
+        )
     }
 
     /// Replaces the map as it was at `stamp_ns` by `change` of it, then replays the growth since
-    /// (a late observation applies at its own time).
-    fn rewrite_at(
+    /// (a late observation applies at its own time); `too_old` when the history no longer
+    /// reaches back to `stamp_ns`.
+    fn rewrite_at<E>(
         &mut self,
         stamp_ns: u64,
-        what: &str,
-        change: impl FnOnce(&Map) -> Result<Map, String>,
-    ) -> Result<(), String> {
-        let i =
-            self.history.iter().rposition(|(t, ..)| *t <= stamp_ns).ok_or(format!(
-                "{what} at {stamp_ns} ns is older than the map's history: stamps out of order"
-            ))?;
+        too_old: impl FnOnce() -> E,
+        change: impl FnOnce(&Map) -> Result<Map, E>,
+    ) -> Result<(), E> {
+        let i = self.history.iter().rposition(|(t, ..)| *t <= stamp_ns).ok_or_else(too_old)?;
         let mut m = change(&self.history[i].1)?;
         self.history[i].1 = m.clone();
         for j in i + 1..self.history.len() {

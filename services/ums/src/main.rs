@@ -26,7 +26,7 @@ struct Args {
     /// Where the robot starts, `x_m,y_m,heading_deg`, instead of the world's `[start]` (a
     /// mission's own start).
     #[arg(long)]
-    start: Option<harvey_world::Pose>,
+    start: Option<harvey_world::Pose2>,
     /// A pose fix places the robot within this square's half side (m)…
     #[arg(long, default_value_t = 0.05)]
     fix_m: f64,

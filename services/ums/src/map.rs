@@ -7,8 +7,8 @@ use std::f64::consts::TAU;
 use harvey_world::Terrain;
 
 use crate::geometry::{self, Pt};
+use harvey_geometry::FT;
 
-const FT: f64 = 0.3048;
 /// Most vertices the published polygon may have (`harvey_msgs::MAX_POLYGON_VERTICES`).
 pub const MAX_VERTICES: usize = harvey_msgs::MAX_POLYGON_VERTICES;
 
@@ -66,11 +66,7 @@ impl Map {
     }
 }
 
-/// An angle in (-π, π].
-pub fn wrap(a: f64) -> f64 {
-    let w = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
-    if w <= -std::f64::consts::PI { w + std::f64::consts::TAU } else { w }
-}
+pub use harvey_geometry::wrap;
 
 /// The growth model: Table 3 statistics of the terrain and the probability in sigmas.
 #[derive(Debug, Clone)]

@@ -93,7 +93,7 @@ fn a_late_sighting_applies_at_its_stamp_and_the_growth_since_is_replayed() {
     let snapshot = u.map().clone();
     let mut old = sighting(0, "north-baseboard", SightingKind::GroundLine, 0.0, -1.0);
     old.header.stamp_ns = 10;
-    assert!(u.on_sighting(&old).expect_err("too old").contains("stamps out of order"));
+    assert!(u.on_sighting(&old).expect_err("too old").to_string().contains("stamps out of order"));
     assert_eq!(u.map(), &snapshot);
 }
 
@@ -107,15 +107,20 @@ fn bad_sightings_are_rejected_with_reasons_and_never_corrupt_the_map() {
     let mut unknown = sighting(100, "office-sign", SightingKind::Bearing, 0.0, 0.0);
     unknown.landmark_index = 999;
     assert!(
-        u.on_sighting(&unknown).expect_err("unknown").contains("landmark #999 which is not in the world")
+        u.on_sighting(&unknown)
+            .expect_err("unknown")
+            .to_string()
+            .contains("landmark #999 which is not in the world")
     );
     let nan = sighting(100, "office-sign", SightingKind::Bearing, f64::NAN, 0.0);
-    assert!(u.on_sighting(&nan).expect_err("nan").contains("non-finite"));
+    assert!(u.on_sighting(&nan).expect_err("nan").to_string().contains("non-finite"));
     // The office sign straight behind the robot: no pose in the map sees it there.
     let impossible = sighting(100, "office-sign", SightingKind::BearingRange, std::f64::consts::PI, 3.0);
     assert!(u.on_sighting(&impossible).is_err());
     assert_eq!(u.map(), &snapshot);
-    assert!(u.on_odometry(&odo(10, 0.0)).expect_err("old odometry").contains("older than the last"));
+    assert!(
+        u.on_odometry(&odo(10, 0.0)).expect_err("old odometry").to_string().contains("older than the last")
+    );
 }
 
 #[test]
@@ -156,7 +161,7 @@ fn a_pose_fix_shrinks_the_map_at_its_stamp_and_a_bad_one_is_refused() {
     let c = u.map().centre;
     assert!((c[0] - 5.0).abs() < 0.1 && (c[1] - 0.04).abs() < 0.01, "{c:?}");
     let bad = harvey_msgs::PoseFix { refined: harvey_msgs::Pose2 { x_m: f64::NAN, ..fix.refined }, ..fix };
-    assert!(u.on_fix(&bad).expect_err("refused").contains("non-finite"));
+    assert!(u.on_fix(&bad).expect_err("refused").to_string().contains("non-finite"));
     assert_eq!(u.map().area_m2(), fixed);
 }
 
@@ -172,9 +177,9 @@ fn a_sighting_rejected_when_it_falls_due_costs_neither_the_map_nor_the_expectati
     let out = u.on_odometry(&odo(300, 1.2)).expect("the odometry itself is sound");
     assert_eq!(map_of(&out).header.seq, 6, "the map goes out, next in sequence");
     assert!(out.iter().any(|o| matches!(o, Output::Expectation(_))));
-    let why: Vec<&str> = out
+    let why: Vec<String> = out
         .iter()
-        .filter_map(|o| if let Output::Rejected(e) = o { Some(e.as_str()) } else { None })
+        .filter_map(|o| if let Output::Rejected(e) = o { Some(e.to_string()) } else { None })
         .collect();
     assert_eq!(why.len(), 1, "{why:?}");
     assert!(why[0].contains("sighting of `office-sign`"), "{why:?}");

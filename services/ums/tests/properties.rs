@@ -1,6 +1,7 @@
 //! Property tests of the map's geometry, over seeded random cases: hulls are convex and hold
 //! their points; slicing never grows a polygon; a sighting consistent with the truth never
 //! removes the true pose, and never grows the map.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use harvey_ums::geometry::{self, Pt};
 use harvey_ums::map::{Growth, Map};

@@ -11,7 +11,7 @@ const RUNS: u64 = 500;
 
 fn campus_on(terrain: &str) -> World {
     let mut w =
-        harvey_world::load_str(include_str!("../../../worlds/campus.toml"), "campus.toml").expect("campus");
+        harvey_world::load_str(include_str!("../../worlds/campus.toml"), "campus.toml").expect("campus");
     assert!(w.start_on_terrain(terrain), "a meadow of {terrain}");
     w
 }
@@ -28,7 +28,7 @@ fn the_truth_stays_inside_the_map_at_its_probability() {
     // (turn degrees, run feet) legs: a dog-leg that stays on each meadow.
     let legs = [(30.0, 8.0), (-45.0, 6.0), (10.0, 4.0)];
     let base =
-        harvey_world::load_str(include_str!("../../../worlds/campus.toml"), "campus.toml").expect("campus");
+        harvey_world::load_str(include_str!("../../worlds/campus.toml"), "campus.toml").expect("campus");
     for (name, terrain) in &base.terrain {
         let world = campus_on(name);
         let growth = Growth { terrain, sigmas: 3.0 };
@@ -37,7 +37,7 @@ fn the_truth_stays_inside_the_map_at_its_probability() {
         for seed in 0..RUNS {
             let mut sim = SimDrv::new(world.clone(), 1000, seed);
             let s = world.start;
-            let mut map = Map::exact(s.x_m, s.y_m, s.heading_deg.to_radians());
+            let mut map = Map::exact(s.x_m, s.y_m, s.heading_rad);
             for (i, (deg, ft)) in legs.iter().enumerate() {
                 let id = 2 * i as u32 + 1;
                 execute(&mut sim, Command::Turn { id, tenths_deg: (deg * 10.0) as i32 });
@@ -46,8 +46,8 @@ fn the_truth_stays_inside_the_map_at_its_probability() {
                 growth.run(&mut map, ft * 0.3048, true);
             }
             let t = sim.truth();
-            let pos = harvey_ums::geometry::contains(&map.polygon, [t.x, t.y], 1e-9);
-            let head = map.contains(map.centre, t.th, 0.0);
+            let pos = harvey_ums::geometry::contains(&map.polygon, [t.x_m, t.y_m], 1e-9);
+            let head = map.contains(map.centre, t.heading_rad, 0.0);
             inside_pos += u32::from(pos);
             inside_heading += u32::from(head);
             inside_both += u32::from(pos && head);

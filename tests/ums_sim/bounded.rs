@@ -21,7 +21,7 @@ impl Noise {
 
 fn run(with_landmarks: bool, seed: u64) -> Vec<f64> {
     let world =
-        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway");
+        harvey_world::load_str(include_str!("../../worlds/hallway.toml"), "hallway").expect("hallway");
     let terrain = world.terrain["tile"].clone();
     let growth = Growth { terrain: &terrain, sigmas: 3.0 };
     // Bearing error of one vision measurement: about two pixels.
@@ -39,19 +39,21 @@ fn run(with_landmarks: bool, seed: u64) -> Vec<f64> {
         growth.run(&mut map, 2.0 * 0.3048, true);
         let t = sim.truth();
         if with_landmarks {
-            for l in world.landmarks.iter().filter(|l| l.active_from(t.x, t.y, t.th.to_degrees())) {
+            for l in
+                world.landmarks.iter().filter(|l| l.active_from(t.x_m, t.y_m, t.heading_rad.to_degrees()))
+            {
                 let c = [l.position_m[0], l.position_m[1]];
                 let known = Known { at: c, to: l.to_m.map(|p| [p[0], p[1]]), position_sd_m: 0.0 };
-                let bearing = wrap((c[1] - t.y).atan2(c[0] - t.x) - t.th);
-                let range = (c[0] - t.x).hypot(c[1] - t.y);
+                let bearing = wrap((c[1] - t.y_m).atan2(c[0] - t.x_m) - t.heading_rad);
+                let range = (c[0] - t.x_m).hypot(c[1] - t.y_m);
                 let obs = match l.class {
                     LandmarkClass::III => {
                         // The baseboard runs along +x at y = 1: the robot is (1 - y) to its right.
                         let (sd_h, sd_o) = (0.01, 0.02);
                         Observation::GroundLine {
-                            heading_rad: wrap(t.th) + noise.within(sd_h),
+                            heading_rad: wrap(t.heading_rad) + noise.within(sd_h),
                             heading_sd_rad: sd_h,
-                            offset_m: t.y - 1.0 + noise.within(sd_o),
+                            offset_m: t.y_m - 1.0 + noise.within(sd_o),
                             offset_sd_m: sd_o,
                         }
                     }
@@ -77,7 +79,7 @@ fn run(with_landmarks: bool, seed: u64) -> Vec<f64> {
                     .unwrap_or_else(|e| panic!("leg {leg}: {} consistent with the truth, yet {e}", l.name));
             }
         }
-        assert!(map.contains([t.x, t.y], t.th, 1e-9), "leg {leg}: truth outside the map");
+        assert!(map.contains([t.x_m, t.y_m], t.heading_rad, 1e-9), "leg {leg}: truth outside the map");
         areas.push(map.area_m2());
     }
     areas

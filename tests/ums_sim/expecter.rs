@@ -11,13 +11,13 @@ use harvey_ums::map::{Growth, Map};
 #[test]
 fn windows_contain_the_truth_and_beat_the_disk_model() {
     let world =
-        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway");
+        harvey_world::load_str(include_str!("../../worlds/hallway.toml"), "hallway").expect("hallway");
     let view = View { camera: &world.camera, width_px: 640, height_px: 480 };
     let (mut sightings, mut inside, mut ratio_sum, mut ratios) = (0u32, 0u32, 0.0, 0u32);
     for seed in 0..500 {
         let mut sim = SimDrv::new(world.clone(), 1000, seed);
         let s = world.start;
-        let mut map = Map::exact(s.x_m, s.y_m, s.heading_deg.to_radians());
+        let mut map = Map::exact(s.x_m, s.y_m, s.heading_rad);
         for (i, (deg, ft)) in [(0.0, 8.0), (8.0, 6.0), (-8.0, 6.0)].iter().enumerate() {
             let id = 2 * i as u32 + 1;
             for cmd in [
@@ -35,12 +35,12 @@ fn windows_contain_the_truth_and_beat_the_disk_model() {
             g.run(&mut map, ft * 0.3048, true);
         }
         let t = sim.truth();
-        for l in world.landmarks.iter().filter(|l| l.active_from(t.x, t.y, t.th.to_degrees())) {
+        for l in world.landmarks.iter().filter(|l| l.active_from(t.x_m, t.y_m, t.heading_rad.to_degrees())) {
             let Some(win) = window(&map, view, l, 0.0) else { continue };
             // Where the landmark really is in the image, seen from the true pose.
-            let truth: Vec<[f64; 2]> = feature_points(l, [t.x, t.y], l.activation_range_m)
+            let truth: Vec<[f64; 2]> = feature_points(l, [t.x_m, t.y_m], l.activation_range_m)
                 .iter()
-                .filter_map(|x| world.camera.project(640, 480, [t.x, t.y, t.th], *x))
+                .filter_map(|x| world.camera.project(640, 480, t, *x))
                 .filter(|[u, v]| (0.0..640.0).contains(u) && (0.0..480.0).contains(v))
                 .collect();
             if truth.is_empty() {

@@ -1,5 +1,6 @@
-//! A small seeded random number generator (SplitMix64) with Gaussian draws: the simulator's only
-//! source of randomness, so one seed gives one run.
+//! The seeded random number generator (SplitMix64) with uniform and Gaussian draws: the only
+//! source of randomness anywhere in Harvey (the simulator, pole placement, the noise schema), so
+//! one seed gives one run on every machine.
 
 /// Seeded generator; the same seed yields the same sequence on every machine.
 #[derive(Debug, Clone)]
@@ -18,6 +19,12 @@ impl Rng {
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1], as `next_u64() / u64::MAX` (the pole placement's and the noise schema's
+    /// draw; [`Rng::uniform`] is the simulator's).
+    pub fn unit(&mut self) -> f64 {
+        self.next_u64() as f64 / u64::MAX as f64
     }
 
     /// Uniform in [0, 1).
@@ -48,5 +55,9 @@ mod tests {
         assert!((var.sqrt() - 0.5).abs() < 0.005, "{}", var.sqrt());
         assert_eq!(Rng::new(1).next_u64(), Rng::new(1).next_u64());
         assert_ne!(Rng::new(1).next_u64(), Rng::new(2).next_u64());
+        // SplitMix64's published first output for seed 0.
+        assert_eq!(Rng::new(0).next_u64(), 0xE220_A839_7B1D_CDAF);
+        let mut u = Rng::new(9);
+        assert!((0..1000).map(|_| u.unit()).all(|x| (0.0..=1.0).contains(&x)));
     }
 }
