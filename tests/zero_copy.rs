@@ -1,6 +1,7 @@
 //! Zero copy, proven across processes: the camera process renders into a loaned shared-memory
 //! slice; this process receives the frame, finds its pixels inside a /dev/shm mapping of its own
 //! address space, and checks them against a local render of the same view.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 
@@ -8,8 +9,8 @@ use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use harvey_bus::{Bus, Waiter, Wake};
-use harvey_camera::{Renderer, checksum};
 use harvey_msgs::{Encoding, topics};
+use harvey_render::{Renderer, checksum};
 
 /// Address ranges of this process's mappings of shared-memory files.
 fn shm_mappings() -> Vec<(usize, usize, String)> {
@@ -80,7 +81,8 @@ fn check(width: u32, height: u32, encoding: Encoding) {
     let world = harvey_world::World::load(&world_path).expect("world");
     let mut renderer = Renderer::new(&world, width, height, encoding);
     let mut expected = vec![0u8; renderer.frame_bytes()];
-    renderer.render(&world, [pose[0], pose[1], pose[2].to_radians()], &mut expected).expect("render");
+    let from = harvey_world::Pose2::from_degrees(pose[0], pose[1], pose[2]);
+    renderer.render(&world, from, &mut expected).expect("render");
     assert_eq!(checksum(pixels), checksum(&expected), "frame content differs from the render");
 
     drop(frame);

@@ -2,25 +2,26 @@
 //! per column) against a straightforward reference that casts one ray per pixel, and against
 //! the memory floor (filling the frame), all measured in the same run. Target: >= 60 frames/s.
 //!
-//! Run: `cargo bench -p harvey-camera --bench render`.
+//! Run: `cargo bench -p harvey-render --bench render`.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 use std::time::Instant;
 
-use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
-use harvey_world::World;
+use harvey_render::Renderer;
+use harvey_world::{Pose2, World};
 
 /// The reference: per pixel, cast the ray through it and shade what it meets first.
-fn reference(world: &World, pose: [f64; 3], out: &mut [u8], w: usize, h: usize) {
+fn reference(world: &World, pose: Pose2, out: &mut [u8], w: usize, h: usize) {
     let cam = &world.camera;
     let f = cam.focal_px * w as f64 / f64::from(cam.width_px);
     for v in 0..h {
         for u in 0..w {
             let off = ((w as f64 / 2.0 - u as f64 - 0.5) / f).atan();
-            let a = pose[2] + off;
+            let a = pose.heading_rad + off;
             let dir = [a.cos(), a.sin()];
             let down = (v as f64 + 0.5 - h as f64 / 2.0) / f;
-            let refl = match world.cast_ray([pose[0], pose[1]], dir, 1e3) {
+            let refl = match world.cast_ray([pose.x_m, pose.y_m], dir, 1e3) {
                 Some(hit) => {
                     let depth = hit.distance_m * off.cos();
                     let z = cam.height_m - down * depth;
@@ -29,7 +30,7 @@ fn reference(world: &World, pose: [f64; 3], out: &mut [u8], w: usize, h: usize) 
                         wall.reflectance_at(hit.along_m, z)
                     } else if z < 0.0 {
                         let range = cam.height_m / down / off.cos();
-                        let p = [pose[0] + dir[0] * range, pose[1] + dir[1] * range];
+                        let p = [pose.x_m + dir[0] * range, pose.y_m + dir[1] * range];
                         let t = world.floor.tile_m;
                         world.floor.reflectance
                             [((p[0] / t).floor() as i64 + (p[1] / t).floor() as i64).rem_euclid(2) as usize]
@@ -63,7 +64,11 @@ fn main() {
     let mut renderer = Renderer::new(&world, w as u32, h as u32, Encoding::Mono8);
     let mut frame = vec![0u8; w * h];
     let pose = |i: usize| {
-        [0.5 + (i % 100) as f64 * 0.1, 0.2 * ((i as f64) * 0.1).sin(), 0.05 * ((i as f64) * 0.07).cos()]
+        Pose2::new(
+            0.5 + (i % 100) as f64 * 0.1,
+            0.2 * ((i as f64) * 0.1).sin(),
+            0.05 * ((i as f64) * 0.07).cos(),
+        )
     };
 
     let harvey = per_frame_ms(300, |i| renderer.render(&world, pose(i), &mut frame).expect("render"));

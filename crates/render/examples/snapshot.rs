@@ -1,9 +1,10 @@
 //! Renders one camera frame of a world from a pose to a PNG, for looking at a world by eye:
-//! `cargo run --release -p harvey-camera --example snapshot -- worlds/hallway.toml 0,0,0 out.png [rgb8]`
+//! `cargo run --release -p harvey-render --example snapshot -- worlds/hallway.toml 0,0,0 out.png [rgb8]`
 //! (pose `x_m,y_m,heading_deg`).
 
-use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
+use harvey_render::Renderer;
+use harvey_world::Pose2;
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -16,7 +17,7 @@ fn main() -> anyhow::Result<()> {
     let (w, h) = (world.camera.width_px, world.camera.height_px);
     let mut r = Renderer::new(&world, w, h, encoding);
     let mut px = vec![0u8; r.frame_bytes()];
-    r.render(&world, [p[0], p[1], p[2].to_radians()], &mut px).map_err(anyhow::Error::msg)?;
+    r.render(&world, Pose2::from_degrees(p[0], p[1], p[2]), &mut px)?;
     match encoding {
         Encoding::Mono8 => image::GrayImage::from_raw(w, h, px).map(|i| i.save(&args[2])),
         Encoding::Rgb8 => image::RgbImage::from_raw(w, h, px).map(|i| i.save(&args[2])),

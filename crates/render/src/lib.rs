@@ -6,7 +6,18 @@ mod effects;
 
 pub use effects::Effects;
 use harvey_msgs::Encoding;
-use harvey_world::World;
+use harvey_world::{Pose2, World};
+
+/// Why a frame could not be rendered.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RenderError {
+    /// The caller's buffer is not [`Renderer::frame_bytes`] long.
+    #[error("frame buffer is {len} bytes, {needed} needed")]
+    BufferSize { len: usize, needed: usize },
+    /// The pose holds a NaN or an infinity (shown as `[x, y, heading]`).
+    #[error("pose {:?} is not finite", [.pose.x_m, .pose.y_m, .pose.heading_rad])]
+    NotFinite { pose: Pose2 },
+}
 
 /// One image column's ray: its direction and the wall it meets.
 #[derive(Debug, Clone, Copy, Default)]
@@ -50,14 +61,14 @@ impl Renderer {
         self.encoding
     }
 
-    /// Renders the view from `(x_m, y_m, heading_rad)` into `out` (exactly `frame_bytes()` long).
-    pub fn render(&mut self, world: &World, pose: [f64; 3], out: &mut [u8]) -> Result<(), String> {
+    /// Renders the view from `pose` into `out` (exactly `frame_bytes()` long).
+    pub fn render(&mut self, world: &World, pose: Pose2, out: &mut [u8]) -> Result<(), RenderError> {
         if out.len() != self.frame_bytes() {
-            return Err(format!("frame buffer is {} bytes, {} needed", out.len(), self.frame_bytes()));
+            return Err(RenderError::BufferSize { len: out.len(), needed: self.frame_bytes() });
         }
-        let [x, y, heading] = pose;
+        let Pose2 { x_m: x, y_m: y, heading_rad: heading } = pose;
         if !(x.is_finite() && y.is_finite() && heading.is_finite()) {
-            return Err(format!("pose {pose:?} is not finite"));
+            return Err(RenderError::NotFinite { pose });
         }
         let cx = f64::from(self.width_px) / 2.0;
         for (u, col) in self.columns.iter_mut().enumerate() {
@@ -87,13 +98,13 @@ impl Renderer {
 
 impl Column {
     /// The ray of the image column whose direction is `tan_left` (left positive) off the axis.
-    fn cast(world: &World, pose: [f64; 3], tan_left: f64) -> Self {
+    fn cast(world: &World, pose: Pose2, tan_left: f64) -> Self {
         let off_axis = tan_left.atan();
-        let a = pose[2] + off_axis;
+        let a = pose.heading_rad + off_axis;
         let dir = [a.cos(), a.sin()];
         let cos_off_axis = off_axis.cos();
         let wall = world
-            .cast_ray([pose[0], pose[1]], dir, 1e3)
+            .cast_ray([pose.x_m, pose.y_m], dir, 1e3)
             .map(|h| (h.distance_m * cos_off_axis, h.wall, h.along_m));
         Column { dir, cos_off_axis, wall }
     }
@@ -124,11 +135,11 @@ impl Column {
 /// The reflectance a ray from the camera at `pose` meets first through image point `(u, v)`
 /// (pixels from the top-left corner) of a `width_px x height_px` image: ray tracing one pixel,
 /// as appearance templates are built (000 §5.3).
-pub fn reflectance_at(world: &World, pose: [f64; 3], width_px: u32, height_px: u32, u: f64, v: f64) -> f64 {
+pub fn reflectance_at(world: &World, pose: Pose2, width_px: u32, height_px: u32, u: f64, v: f64) -> f64 {
     let f = world.camera.focal_for(width_px);
     let (cx, cy) = (f64::from(width_px) / 2.0, f64::from(height_px) / 2.0);
     let col = Column::cast(world, pose, (cx - u) / f);
-    col.appearance(world, [pose[0], pose[1]], (v - cy) / f).0
+    col.appearance(world, [pose.x_m, pose.y_m], (v - cy) / f).0
 }
 
 /// Reflectance of the floor tile seen at optical depth `depth_m` along a column.
@@ -158,7 +169,7 @@ mod tests {
         let w = hallway();
         let mut r = Renderer::new(&w, 640, 480, Encoding::Mono8);
         let mut img = vec![0u8; r.frame_bytes()];
-        r.render(&w, [5.0, 0.0, 0.0], &mut img).expect("renders");
+        r.render(&w, Pose2::new(5.0, 0.0, 0.0), &mut img).expect("renders");
         let at = |u: usize, v: usize| img[v * 640 + u];
         let lit = |refl: f64| (w.camera.illumination * refl).round() as u8;
         // The end wall straight ahead, 11 m away, at camera height: the row through the centre.
@@ -171,7 +182,7 @@ mod tests {
         assert_eq!(at(0, 240), lit(0.70));
         // From x = 2 the column through the middle of the lab's doorway (x = 4.45 on the north
         // wall) sees through the opening to the lab's east wall (reflectance 0.50).
-        r.render(&w, [2.0, 0.0, 0.0], &mut img).expect("renders");
+        r.render(&w, Pose2::new(2.0, 0.0, 0.0), &mut img).expect("renders");
         let f = w.camera.focal_px;
         let u = (320.0 - f * (1.0 / 2.45) - 0.5).round() as usize;
         assert_eq!(img[240 * 640 + u], lit(0.50), "column {u}");
@@ -183,7 +194,7 @@ mod tests {
         let mut r = Renderer::new(&w, 640, 480, Encoding::Rgb8);
         let mut img = vec![0u8; r.frame_bytes()];
         // Facing the red sign (x 12.2-12.6, z 1.4-1.7 on the north wall) from 1 m in front of it.
-        r.render(&w, [12.4, 0.0, std::f64::consts::FRAC_PI_2], &mut img).expect("renders");
+        r.render(&w, Pose2::new(12.4, 0.0, std::f64::consts::FRAC_PI_2), &mut img).expect("renders");
         // The sign's centre, 0.35 m above the camera at 1 m: 0.35 x 554 px above the centre row.
         let v = (240.0 - 0.35 * w.camera.focal_px).round() as usize;
         let px = &img[(v * 640 + 320) * 3..(v * 640 + 320) * 3 + 3];
@@ -199,11 +210,13 @@ mod tests {
         let mut a = vec![0u8; mono.frame_bytes()];
         let mut b = vec![0u8; rgb.frame_bytes()];
         // Looking back down the hall at the west end wall: no coloured region in view.
-        mono.render(&w, [1.0, 0.2, std::f64::consts::PI], &mut a).expect("renders");
-        rgb.render(&w, [1.0, 0.2, std::f64::consts::PI], &mut b).expect("renders");
+        mono.render(&w, Pose2::new(1.0, 0.2, std::f64::consts::PI), &mut a).expect("renders");
+        rgb.render(&w, Pose2::new(1.0, 0.2, std::f64::consts::PI), &mut b).expect("renders");
         assert!(a.iter().zip(b.chunks_exact(3)).all(|(g, p)| p == [*g, *g, *g]));
-        assert!(mono.render(&w, [0.0, 0.0, 0.0], &mut b).is_err());
-        assert!(mono.render(&w, [f64::NAN, 0.0, 0.0], &mut a).is_err());
+        let e = mono.render(&w, Pose2::default(), &mut b).expect_err("an rgb8 buffer for mono8");
+        assert_eq!(e.to_string(), "frame buffer is 9216 bytes, 3072 needed");
+        let e = mono.render(&w, Pose2::new(f64::NAN, 0.0, 0.0), &mut a).expect_err("NaN");
+        assert_eq!(e.to_string(), "pose [NaN, 0.0, 0.0] is not finite");
         assert_ne!(checksum(&a), checksum(&a[1..]));
     }
 }

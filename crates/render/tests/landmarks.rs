@@ -1,16 +1,17 @@
 //! What the camera renders agrees with the calibration the Expecter uses: landmarks appear
 //! within 0.5 px of their projection, and regions' intensities stand in the ratio of their
 //! reflectances (pixel = illumination x reflectance).
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
-use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
-use harvey_world::World;
+use harvey_render::Renderer;
+use harvey_world::{Pose2, World};
 
 fn hallway() -> World {
     harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
 }
 
-fn render(w: &World, pose: [f64; 3]) -> Vec<u8> {
+fn render(w: &World, pose: Pose2) -> Vec<u8> {
     let mut r = Renderer::new(w, 640, 480, Encoding::Mono8);
     let mut img = vec![0u8; r.frame_bytes()];
     r.render(w, pose, &mut img).expect("renders");
@@ -21,7 +22,7 @@ fn render(w: &World, pose: [f64; 3]) -> Vec<u8> {
 fn a_door_jamb_appears_where_the_calibration_projects_it() {
     let w = hallway();
     let jamb = w.landmark("lab-door-east-jamb").expect("landmark");
-    for pose in [[2.0, 0.0, 0.3], [1.0, -0.4, 0.5], [0.0, 0.3, 0.2]] {
+    for pose in [Pose2::new(2.0, 0.0, 0.3), Pose2::new(1.0, -0.4, 0.5), Pose2::new(0.0, 0.3, 0.2)] {
         // A point on the jamb at 1 m height, and the row it projects to.
         let p = [jamb.position_m[0], jamb.position_m[1], 1.0];
         let [u, v] = w.camera.project(640, 480, pose, p).expect("in view");
@@ -42,7 +43,7 @@ fn a_door_jamb_appears_where_the_calibration_projects_it() {
 fn the_sign_is_centred_on_its_projection_with_the_reflectance_ratio() {
     let w = hallway();
     let sign = w.landmark("office-sign").expect("landmark");
-    let pose = [12.4, -0.9, std::f64::consts::FRAC_PI_2];
+    let pose = Pose2::new(12.4, -0.9, std::f64::consts::FRAC_PI_2);
     let img = render(&w, pose);
     let lit = |r: f64| (w.camera.illumination * r).round() as u8;
     let (mut n, mut su, mut sv) = (0.0, 0.0, 0.0);

@@ -1,5 +1,6 @@
 //! Bench rows for the kernels that work on lines, corners or frame pairs: stereo, depth from
 //! motion, the constrained Hough transform and path following, each against its reference.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 use std::hint::black_box;
 
@@ -10,13 +11,13 @@ use harvey_vision::moravec::MoravecParams;
 use harvey_vision::path::{ImageLine, PathParams, PathTracker};
 use harvey_vision::stereo::{Stereo, StereoParams};
 use harvey_vision::{GrayBuf, Rect};
-use harvey_world::World;
+use harvey_world::{Pose2, World};
 
 use crate::sidewalk::sidewalk;
 use crate::{Row, around, frame_at, measure, reference, reference_geometry, textured};
 
 /// Where the bench frames are taken from (the kernels bench's own frame).
-pub const POSE: [f64; 3] = [0.5, -0.3, 0.05];
+pub const POSE: Pose2 = Pose2::new(0.5, -0.3, 0.05);
 
 const CORNERS: MoravecParams =
     MoravecParams { window: 5, threshold: 3000, suppress_radius: 4, max_corners: 120 };
@@ -30,8 +31,8 @@ fn scopes(img: &GrayBuf, side: usize) -> [(String, Rect); 2] {
 }
 
 pub fn bench_stereo(world: &World, left: &GrayBuf, size: &str, rows: &mut Vec<Row>) {
-    let (c, s) = (POSE[2].cos(), POSE[2].sin());
-    let right_pose = [POSE[0] + 0.3 * s, POSE[1] - 0.3 * c, POSE[2]];
+    let (c, s) = (POSE.heading_rad.cos(), POSE.heading_rad.sin());
+    let right_pose = Pose2 { x_m: POSE.x_m + 0.3 * s, y_m: POSE.y_m - 0.3 * c, ..POSE };
     let right = frame_at(world, left.width as u32, left.height as u32, right_pose);
     let p = StereoParams {
         focal_px: world.camera.focal_for(left.width as u32) as f32,
@@ -74,8 +75,16 @@ pub fn bench_stereo(world: &World, left: &GrayBuf, size: &str, rows: &mut Vec<Ro
 pub fn bench_depth(world: &World, first: &GrayBuf, size: &str, rows: &mut Vec<Row>) {
     let (w, h) = (first.width as u32, first.height as u32);
     let step = 0.15;
-    let next =
-        frame_at(world, w, h, [POSE[0] + step * POSE[2].cos(), POSE[1] + step * POSE[2].sin(), POSE[2]]);
+    let next = frame_at(
+        world,
+        w,
+        h,
+        Pose2 {
+            x_m: POSE.x_m + step * POSE.heading_rad.cos(),
+            y_m: POSE.y_m + step * POSE.heading_rad.sin(),
+            ..POSE
+        },
+    );
     let p = DepthParams {
         foe: [w as f32 / 2.0, h as f32 / 2.0],
         focal_px: world.camera.focal_for(w) as f32,

@@ -4,6 +4,7 @@
 //! `target/vision-bench/` for `scripts/bench-opencv`, which times OpenCV on the same images.
 //!
 //! `taskset -c 0 cargo bench -p harvey-vision --bench kernels`
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 mod geometry;
 mod reference;
@@ -15,8 +16,8 @@ use std::hint::black_box;
 use std::path::Path;
 use std::time::Instant;
 
-use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
+use harvey_render::Renderer;
 use harvey_vision::cues::{ActivityDetector, ActivityVote, brightest};
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::frs::{ClassRange, Frs};
@@ -70,7 +71,7 @@ fn frame(world: &harvey_world::World, w: u32, h: u32) -> GrayBuf {
     frame_at(world, w, h, geometry::POSE)
 }
 
-fn frame_at(world: &harvey_world::World, w: u32, h: u32, pose: [f64; 3]) -> GrayBuf {
+fn frame_at(world: &harvey_world::World, w: u32, h: u32, pose: harvey_world::Pose2) -> GrayBuf {
     let mut r = Renderer::new(world, w, h, Encoding::Mono8);
     let mut px = vec![0u8; r.frame_bytes()];
     r.render(world, pose, &mut px).expect("renders");

@@ -1,5 +1,6 @@
 //! Straightforward reference implementations: the formulas as written, no reuse, no tricks. The
 //! benchmark times each kernel against its reference in the same run.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 use harvey_vision::{Gray, GrayBuf, Rect};
 

@@ -1,6 +1,7 @@
 //! Straightforward references for the kernels that build on others: stereo and depth from
 //! motion from the reference Moravec operator and correlation, and the constrained Hough
 //! transform with one full-resolution accumulator per hypothesis.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 use harvey_vision::flf::Line;
 use harvey_vision::hough::{DockModel, Hypothesis};

@@ -1,13 +1,14 @@
 //! Depth from motion on rendered frames (001 §2.3, Table 1): the camera drives straight down the
 //! hallway towards a box on the floor; tracked points' depths sharpen with every frame, and the
 //! row-against-inverse-depth fit separates the box's points from the floor's.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
-use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
+use harvey_render::Renderer;
 use harvey_vision::depth::{DepthFromMotion, DepthParams, Track, obstacles};
 use harvey_vision::moravec::MoravecParams;
 use harvey_vision::{Gray, Rect};
-use harvey_world::{Wall, World};
+use harvey_world::{Pose2, Wall, World};
 
 mod common;
 
@@ -32,7 +33,7 @@ fn world_with_box() -> World {
 
 /// What a tracked feature sees: its depth, and whether it stands off the floor (at least 10 cm
 /// up: a wall's foot is floor to any camera).
-fn feature_truth(w: &World, pose: [f64; 3], at: [f32; 2]) -> (f64, bool) {
+fn feature_truth(w: &World, pose: Pose2, at: [f32; 2]) -> (f64, bool) {
     let (depth, height) = common::feature(w, [W, H], pose, at);
     (depth, height > 0.10)
 }
@@ -60,7 +61,7 @@ fn depths_sharpen_frame_by_frame_and_the_box_stands_off_the_floor() {
     let mut start_depth: Vec<f64> = Vec::new();
     for k in 0..9 {
         let travelled = k as f64 * step;
-        let pose = [travelled, 0.0, 0.0];
+        let pose = Pose2::new(travelled, 0.0, 0.0);
         r.render(&w, pose, &mut px).expect("renders");
         let img = Gray::new(&px, W as usize, H as usize, W as usize).expect("frame");
         if k == 0 {
@@ -100,7 +101,7 @@ fn depths_sharpen_frame_by_frame_and_the_box_stands_off_the_floor() {
     assert!(last.1 < 0.5 * first.1 && last.2 < 0.3 * first.2, "no sharpening: {first:?} -> {last:?}");
 
     // The box's points stand off the floor's ground line; the floor's lie on it.
-    let pose = [8.0 * step, 0.0, 0.0];
+    let pose = Pose2::new(8.0 * step, 0.0, 0.0);
     let tracks: Vec<&Track> = dfm.tracks().filter(|t| t.depth.is_some()).collect();
     let off = obstacles(&tracks, params.foe[1], 2.0, 0.08, 0.1);
     let judged: Vec<(&&Track, bool)> =

@@ -2,6 +2,7 @@
 //! across the image frame by frame; the grouped edges, centreline and vanishing point follow it
 //! from a bootstrap prediction 10 px and 3 degrees off; with an edge hidden, the path is lost
 //! (confidence too low even with widened tolerances) and the last model is kept.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::path::{ImageLine, PathParams, PathTracker};

@@ -1,13 +1,14 @@
 //! Two-camera stereo on rendered frames (003): parallel cameras 0.3 m apart in the hallway; the
 //! depths of matched interesting points agree with ray-cast truth, matches keep to the near/far
 //! limits, and a right camera two rows out of alignment is still matched within its band.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
-use harvey_camera::Renderer;
 use harvey_msgs::Encoding;
+use harvey_render::Renderer;
 use harvey_vision::moravec::MoravecParams;
 use harvey_vision::stereo::{Stereo, StereoParams};
 use harvey_vision::{Gray, Rect};
-use harvey_world::World;
+use harvey_world::{Pose2, World};
 
 mod common;
 
@@ -18,7 +19,7 @@ fn hallway() -> World {
     harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
 }
 
-fn render(w: &World, pose: [f64; 3]) -> Vec<u8> {
+fn render(w: &World, pose: Pose2) -> Vec<u8> {
     let mut r = Renderer::new(w, W, H, Encoding::Mono8);
     let mut px = vec![0u8; r.frame_bytes()];
     r.render(w, pose, &mut px).expect("renders");
@@ -41,10 +42,10 @@ fn params(w: &World, band_rows: usize) -> StereoParams {
 #[test]
 fn stereo_depths_agree_with_the_truth_within_the_near_far_limits() {
     let w = hallway();
-    let left_pose: [f64; 3] = [2.0, 0.15, 0.1];
-    let (c, s) = (left_pose[2].cos(), left_pose[2].sin());
+    let left_pose = Pose2::new(2.0, 0.15, 0.1);
+    let (c, s) = (left_pose.heading_rad.cos(), left_pose.heading_rad.sin());
     // The right camera 0.3 m to the right (minus y in the camera's own frame).
-    let right_pose = [left_pose[0] + 0.3 * s, left_pose[1] - 0.3 * c, left_pose[2]];
+    let right_pose = Pose2 { x_m: left_pose.x_m + 0.3 * s, y_m: left_pose.y_m - 0.3 * c, ..left_pose };
     let (l, r) = (render(&w, left_pose), render(&w, right_pose));
     let (lg, rg) =
         (Gray::new(&l, 640, 480, 640).expect("left"), Gray::new(&r, 640, 480, 640).expect("right"));

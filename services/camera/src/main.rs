@@ -9,9 +9,9 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, FramePublisher, Pace, Step, Waiter, Wake};
-use harvey_camera::{Effects, Renderer, checksum};
 use harvey_msgs::{Encoding, FrameHeader, topics};
-use harvey_world::World;
+use harvey_render::{Effects, Renderer, checksum};
+use harvey_world::{Pose2, World};
 
 #[derive(Parser)]
 #[command(about = "Simulated camera rendering into shared memory, or a folder of images played as frames")]
@@ -59,14 +59,14 @@ struct Camera {
 }
 
 impl Camera {
-    fn shoot(&mut self, pose: [f64; 3], stamp_ns: u64) -> anyhow::Result<()> {
+    fn shoot(&mut self, pose: Pose2, stamp_ns: u64) -> anyhow::Result<()> {
         self.seq += 1;
         // Moving things where they are at the frame's simulated time.
         self.world.set_time(stamp_ns as f64 * 1e-9);
         let r = &self.renderer;
         let header = FrameHeader::new(self.seq, stamp_ns, r.width_px(), r.height_px(), r.encoding());
         let mut frame = self.publisher.loan(header)?;
-        self.renderer.render(&self.world, pose, frame.pixels_mut()).map_err(anyhow::Error::msg)?;
+        self.renderer.render(&self.world, pose, frame.pixels_mut())?;
         let (w, h, bpp) = (
             header.width_px as usize,
             header.height_px as usize,
@@ -122,7 +122,7 @@ fn main() -> anyhow::Result<()> {
     }
     let world_path = args.world.as_ref().context("--world or --images is required")?;
     let mut world = World::load(world_path)?;
-    world.place_poles(args.seed).map_err(anyhow::Error::msg)?;
+    world.place_poles(args.seed)?;
     if let Some(file) = &args.movers {
         world.add_movers(harvey_world::load_movers(file)?);
     }
@@ -145,7 +145,7 @@ fn main() -> anyhow::Result<()> {
     if let Some(p) = args.pose {
         anyhow::ensure!(p.len() == 3, "--pose takes x_m,y_m,heading_deg; got {} values", p.len());
         anyhow::ensure!(args.rate_hz > 0.0, "--rate-hz must be positive");
-        let pose = [p[0], p[1], p[2].to_radians()];
+        let pose = Pose2::from_degrees(p[0], p[1], p[2]);
         let _tick = waiter.attach_interval(Duration::from_secs_f64(1.0 / args.rate_hz))?;
         harvey_runtime::notify_ready()?;
         let period_ns = (1e9 / args.rate_hz) as u64;
@@ -164,8 +164,7 @@ fn main() -> anyhow::Result<()> {
     while pace.next(&waiter, None)? != Step::Stop {
         truth.drain_into(&mut poses)?;
         for t in poses.iter().filter(|t| t.header.seq % every == 0) {
-            let p = t.world_from_robot;
-            cam.shoot([p.x_m, p.y_m, p.heading_rad], t.header.stamp_ns)?;
+            cam.shoot(t.world_from_robot, t.header.stamp_ns)?;
         }
         pace.done()?;
     }

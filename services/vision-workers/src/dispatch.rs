@@ -248,9 +248,8 @@ impl Dispatcher {
                     .ok_or(VisionStatus::UnknownLandmark)?;
                 let base = l.point();
                 let point = [0, 1, 2].map(|k| base[k] + f64::from(req.params[2 + k]));
-                let e = req.expected;
                 let side = param(req, 0, 16.0) as usize;
-                let pose = [e.x_m, e.y_m, e.heading_rad];
+                let pose = req.expected;
                 if !build_into(&mut self.template, &self.world, pose, point, [h.width_px, h.height_px], side)
                 {
                     return Err(VisionStatus::BadTemplate);

@@ -12,6 +12,16 @@ pub mod templates;
 
 pub const ALGO_VERTICAL_EDGES: u32 = 1;
 
+/// Why a frame could not be searched for edges.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FrameError {
+    #[error("frame {seq}: unknown encoding {encoding}")]
+    UnknownEncoding { seq: u64, encoding: u32 },
+    /// The header's size and stride ask for more bytes than the frame holds (or are degenerate).
+    #[error("frame {seq}: {width_px}x{height_px} stride {stride_bytes} does not fit {len} bytes")]
+    DoesNotFit { seq: u64, width_px: usize, height_px: usize, stride_bytes: usize, len: usize },
+}
+
 /// Finds vertical edges in a band of rows; keeps its scratch between frames.
 #[derive(Debug)]
 pub struct VerticalEdges {
@@ -30,18 +40,20 @@ impl VerticalEdges {
     }
 
     /// Runs on one frame (mono8 or rgb8, first channel used).
-    pub fn run(&mut self, h: &FrameHeader, pixels: &[u8]) -> Result<Detections, String> {
+    pub fn run(&mut self, h: &FrameHeader, pixels: &[u8]) -> Result<Detections, FrameError> {
         let bpp = h
             .encoding()
-            .ok_or_else(|| format!("frame {}: unknown encoding {}", h.seq, h.encoding))?
+            .ok_or(FrameError::UnknownEncoding { seq: h.seq, encoding: h.encoding })?
             .bytes_per_pixel() as usize;
         let (w, ht, stride) = (h.width_px as usize, h.height_px as usize, h.stride_bytes as usize);
         if w < 3 || ht == 0 || stride < w * bpp || pixels.len() < stride * ht {
-            return Err(format!(
-                "frame {}: {w}x{ht} stride {stride} does not fit {} bytes",
-                h.seq,
-                pixels.len()
-            ));
+            return Err(FrameError::DoesNotFit {
+                seq: h.seq,
+                width_px: w,
+                height_px: ht,
+                stride_bytes: stride,
+                len: pixels.len(),
+            });
         }
         let mid = ht / 2;
         let half = (self.band_half_rows as usize).min(mid);
@@ -107,8 +119,10 @@ mod tests {
     fn malformed_frames_are_errors_not_crashes() {
         let mut e = VerticalEdges::new(8, 20.0);
         let header = FrameHeader::new(1, 0, 64, 48, Encoding::Mono8);
-        assert!(e.run(&header, &[0u8; 100]).is_err());
+        let short = e.run(&header, &[0u8; 100]).expect_err("too short");
+        assert_eq!(short.to_string(), "frame 1: 64x48 stride 64 does not fit 100 bytes");
         let bad = FrameHeader { encoding: 99, ..header };
-        assert!(e.run(&bad, &[0u8; 64 * 48]).is_err());
+        let unknown = e.run(&bad, &[0u8; 64 * 48]).expect_err("encoding 99");
+        assert_eq!(unknown.to_string(), "frame 1: unknown encoding 99");
     }
 }

@@ -4,7 +4,7 @@
 //! distinctive: the reflectance step across them is large. These are the points whose
 //! appearance templates (`templates.rs`) correlation then finds.
 
-use harvey_world::World;
+use harvey_world::{Pose2, World};
 
 /// A selected vertex.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -22,7 +22,7 @@ pub struct Vertex {
 /// within `range_m`, with a reflectance step of at least `min_contrast`; strongest first.
 pub fn select(
     world: &World,
-    pose: [f64; 3],
+    pose: Pose2,
     [width, height]: [u32; 2],
     margin_px: f64,
     range_m: f64,
@@ -49,13 +49,13 @@ pub fn select(
                     let p = [w.from[0] + dir[0] * along, w.from[1] + dir[1] * along, z];
                     let Some([u, v]) = world.camera.project(width, height, pose, p) else { continue };
                     let inside = |a: f64, max: u32| a >= margin_px && a <= f64::from(max) - margin_px;
-                    let (dx, dy) = (p[0] - pose[0], p[1] - pose[1]);
+                    let (dx, dy) = (p[0] - pose.x_m, p[1] - pose.y_m);
                     let dist = dx.hypot(dy);
                     if !inside(u, width) || !inside(v, height) || dist > range_m {
                         continue;
                     }
                     // Nothing nearer on the way (the vertex's own wall is hit at its distance).
-                    let hit = world.cast_ray([pose[0], pose[1]], [dx / dist, dy / dist], dist + 1.0);
+                    let hit = world.cast_ray([pose.x_m, pose.y_m], [dx / dist, dy / dist], dist + 1.0);
                     if hit.is_some_and(|h| h.distance_m < dist - 0.05) {
                         continue;
                     }
@@ -81,7 +81,7 @@ mod tests {
     #[test]
     fn the_office_signs_corners_are_selected_in_view_and_hidden_ones_are_not() {
         let w = hallway();
-        let pose = [8.0, 0.0, 0.3];
+        let pose = Pose2::new(8.0, 0.0, 0.3);
         let v = select(&w, pose, [640, 480], 16.0, 12.0, 0.15);
         assert!(!v.is_empty());
         // The red sign (x 12.2–12.6, z 1.4–1.7 on the north wall) is a strong vertex source.
@@ -97,7 +97,7 @@ mod tests {
         }
         assert!(v.windows(2).all(|p| p[0].contrast.abs() >= p[1].contrast.abs()));
         // Looking the other way, the sign is behind the camera: not selected.
-        let back = select(&w, [8.0, 0.0, std::f64::consts::PI], [640, 480], 16.0, 12.0, 0.15);
+        let back = select(&w, Pose2::new(8.0, 0.0, std::f64::consts::PI), [640, 480], 16.0, 12.0, 0.15);
         assert!(back.iter().all(|x| x.point_m[0] < 8.0), "{back:#?}");
     }
 }

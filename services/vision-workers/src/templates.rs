@@ -4,7 +4,7 @@
 //! needs no model of the lighting.
 
 use harvey_vision::{GrayBuf, Rect};
-use harvey_world::World;
+use harvey_world::{Pose2, World};
 
 /// A template and where it sits in the image.
 #[derive(Debug, Clone, PartialEq)]
@@ -29,7 +29,7 @@ impl AppearanceTemplate {
 /// leave the image.
 pub fn build(
     world: &World,
-    pose: [f64; 3],
+    pose: Pose2,
     point_m: [f64; 3],
     width: u32,
     height: u32,
@@ -43,7 +43,7 @@ pub fn build(
 pub fn build_into(
     out: &mut AppearanceTemplate,
     world: &World,
-    pose: [f64; 3],
+    pose: Pose2,
     point_m: [f64; 3],
     [width, height]: [u32; 2],
     side: usize,
@@ -65,7 +65,7 @@ pub fn build_into(
     for j in 0..side {
         px.data.extend((0..side).map(|i| {
             let (pu, pv) = ((x0 + i) as f64 + 0.5, (y0 + j) as f64 + 0.5);
-            let r = harvey_camera::reflectance_at(world, pose, width, height, pu, pv);
+            let r = harvey_render::reflectance_at(world, pose, width, height, pu, pv);
             (255.0 * r).round().clamp(0.0, 255.0) as u8
         }));
     }

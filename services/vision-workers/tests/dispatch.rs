@@ -1,12 +1,13 @@
 //! The vision workers' request protocol on rendered frames: every algorithm answers with the
 //! frame's seq and stamp; bad requests get an error status; two workers sharing the requests
 //! give the answers one worker gives; and answering a frame allocates nothing once warm.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use harvey_camera::Renderer;
 use harvey_msgs::{Encoding, FrameHeader, Pose2, VisionAlgorithm, VisionRequest, VisionResult, VisionStatus};
+use harvey_render::Renderer;
 use harvey_vision_workers::dispatch::Dispatcher;
 use harvey_world::World;
 
@@ -34,7 +35,7 @@ fn hallway() -> World {
     harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
 }
 
-const POSE: [f64; 3] = [8.0, 0.0, 0.3];
+const POSE: Pose2 = Pose2::new(8.0, 0.0, 0.3);
 
 fn frame(w: &World, seq: u64) -> (FrameHeader, Vec<u8>) {
     let mut r = Renderer::new(w, 640, 480, Encoding::Mono8);
@@ -52,7 +53,7 @@ fn sign_index(w: &World) -> u32 {
 }
 
 fn requests(w: &World) -> Vec<VisionRequest> {
-    let expected = Pose2 { x_m: POSE[0], y_m: POSE[1], heading_rad: POSE[2] };
+    let expected = POSE;
     let mut lines = request(3, VisionAlgorithm::LineFinder);
     lines.params[4..6].copy_from_slice(&[80.0, 100.0]); // near-vertical lines only
     let mut regions = request(4, VisionAlgorithm::RegionSegmenter);
@@ -192,7 +193,7 @@ fn phototropic_and_activity_requests() {
     assert_eq!(status(&d.answer(&h, &px, &act)), VisionStatus::NotFound, "no motion");
     let mut moved = Renderer::new(&w, 640, 480, Encoding::Mono8);
     let mut px2 = vec![0u8; moved.frame_bytes()];
-    moved.render(&w, [POSE[0] + 0.3, POSE[1], POSE[2]], &mut px2).expect("renders");
+    moved.render(&w, Pose2 { x_m: POSE.x_m + 0.3, ..POSE }, &mut px2).expect("renders");
     let r = d.answer(&FrameHeader::new(3, 300_000_000, 640, 480, Encoding::Mono8), &px2, &act);
     assert_eq!(status(&r), VisionStatus::Found, "{r:?}");
     assert!(r.items[0].values[2] > 0.0);
@@ -204,7 +205,7 @@ fn the_dock_is_recognised_on_the_bus_with_its_posts_heights() {
     let mut r = Renderer::new(&w, 640, 480, Encoding::Mono8);
     let mut px = vec![0u8; r.frame_bytes()];
     // 3.6 m from the dock's face, 0.4 m to its right, turned 8 degrees towards it.
-    let pose = [10.0, -0.4, 8f64.to_radians()];
+    let pose = Pose2::new(10.0, -0.4, 8f64.to_radians());
     r.render(&w, pose, &mut px).expect("renders");
     let h = FrameHeader::new(1, 100_000_000, 640, 480, Encoding::Mono8);
     let mut d = Dispatcher::new(w.clone());
@@ -236,7 +237,7 @@ fn the_dock_is_recognised_on_the_bus_with_its_posts_heights() {
         "{found:?}"
     );
     // Looking away from the dock: not found.
-    r.render(&w, [10.0, -0.4, 1.5], &mut px).expect("renders");
+    r.render(&w, Pose2::new(10.0, -0.4, 1.5), &mut px).expect("renders");
     assert_eq!(status(&d.answer(&h, &px, &dock)), VisionStatus::NotFound);
     dock.params[0] = f32::NAN;
     assert_eq!(status(&d.answer(&h, &px, &dock)), VisionStatus::BadParameter);
@@ -254,7 +255,7 @@ fn coded_poles_are_recognised_with_their_range_and_code() {
     // From the start, looking round in steps of half the field of view: every pole in view and
     // unhidden within 10 m is found with its code and its range to within 3 %.
     for k in 0..12 {
-        let pose = [w.start.x_m, w.start.y_m, f64::from(k) * 30f64.to_radians()];
+        let pose = Pose2 { heading_rad: f64::from(k) * 30f64.to_radians(), ..w.start };
         r.render(&w, pose, &mut px).expect("renders");
         let res = d.answer(&h, &px, &request(12, VisionAlgorithm::Poles));
         if res.count > 0 {
@@ -263,7 +264,8 @@ fn coded_poles_are_recognised_with_their_range_and_code() {
         for item in &res.items[..res.count as usize] {
             let [u, range, code, ..] = item.values;
             let p = poles.iter().find(|p| p.code == code as u32).expect("a real code");
-            let depth = (p.at[0] - pose[0]) * pose[2].cos() + (p.at[1] - pose[1]) * pose[2].sin();
+            let depth =
+                (p.at[0] - pose.x_m) * pose.heading_rad.cos() + (p.at[1] - pose.y_m) * pose.heading_rad.sin();
             assert!(
                 (f64::from(range) / depth - 1.0).abs() < 0.03,
                 "pole {code}: {range} m against {depth} m"

@@ -1,16 +1,16 @@
 //! Ground truth for tests on rendered frames: what a pixel sees, by casting its ray.
 
-use harvey_world::World;
+use harvey_world::{Pose2, World};
 
 /// Depth along the optical axis of what image point `at` of a `size` image from `pose` sees,
 /// and the height of that point above the floor (0 for the floor itself).
-pub fn seen(w: &World, size: [u32; 2], pose: [f64; 3], at: [f32; 2]) -> (f64, f64) {
+pub fn seen(w: &World, size: [u32; 2], pose: Pose2, at: [f32; 2]) -> (f64, f64) {
     let f = w.camera.focal_for(size[0]);
     let left = (f64::from(size[0]) / 2.0 - f64::from(at[0])) / f;
     let down = (f64::from(at[1]) - f64::from(size[1]) / 2.0) / f;
-    let a = pose[2] + left.atan();
+    let a = pose.heading_rad + left.atan();
     let floor = if down > 0.0 { w.camera.height_m / down } else { f64::INFINITY };
-    match w.cast_ray([pose[0], pose[1]], [a.cos(), a.sin()], 1e3) {
+    match w.cast_ray([pose.x_m, pose.y_m], [a.cos(), a.sin()], 1e3) {
         Some(hit) => {
             let depth = hit.distance_m * left.atan().cos();
             let z = w.camera.height_m - down * depth;
@@ -22,7 +22,7 @@ pub fn seen(w: &World, size: [u32; 2], pose: [f64; 3], at: [f32; 2]) -> (f64, f6
 
 /// [`seen`] for a tracked feature: a corner on an occluding edge moves with the nearer surface,
 /// so when something within 2 px is more than 15 % nearer, that is what it sees.
-pub fn feature(w: &World, size: [u32; 2], pose: [f64; 3], at: [f32; 2]) -> (f64, f64) {
+pub fn feature(w: &World, size: [u32; 2], pose: Pose2, at: [f32; 2]) -> (f64, f64) {
     let centre = seen(w, size, pose, at);
     let offsets = (-2..=2).flat_map(|i| (-2..=2).map(move |j| [i as f32, j as f32]));
     let nearest = offsets
