@@ -4,8 +4,8 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::Context;
 use harvey_msgs::{CheckOutcome, MissionState, MissionStatus, PlanSketch, TruePose, UncertaintyMap};
+use harvey_recording::Recording;
 
 /// One line of the summary: a labelled pose, its heading in (-180, 180] degrees.
 fn pose_line(label: &str, p: &harvey_msgs::Pose2) -> String {
@@ -46,41 +46,38 @@ pub struct RunStats {
 
 impl RunStats {
     pub fn read(path: &Path) -> anyhow::Result<Self> {
-        let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+        let recording = Recording::open(path)?;
         let mut run = RunStats::default();
         let mut true_path: Vec<(f64, [f64; 2])> = Vec::new();
-        let stream = mcap::MessageStream::new(&bytes)
-            .with_context(|| format!("{}: not an MCAP file", path.display()))?;
-        for (i, m) in stream.enumerate() {
-            let m = m.with_context(|| format!("{}: corrupt after {i} messages", path.display()))?;
-            let topic = m.channel.topic.trim_start_matches('/').to_owned();
+        for m in recording.messages()? {
+            let m = m?;
+            let topic = m.topic().to_owned();
             let t = run.topics.entry(topic.clone()).or_default();
             if t.messages == 0 {
-                t.first_ns = m.log_time;
-                t.schema = m.channel.schema.as_ref().map(|s| s.name.clone()).unwrap_or_default();
+                t.first_ns = m.log_time();
+                t.schema = m.schema().to_owned();
             }
             t.messages += 1;
-            t.last_ns = m.log_time;
-            let bad = |e| anyhow::anyhow!("{}: message {i} on /{topic}: {e}", path.display());
+            t.last_ns = m.log_time();
             match topic.as_str() {
-                "executive/status" => run.last_status = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
+                "executive/status" => run.last_status = Some(m.decode()?),
                 "sim/truth" => {
-                    let t: TruePose = harvey_cdr::decode(&m.data).map_err(bad)?;
+                    let t: TruePose = m.decode()?;
                     let p = t.world_from_robot;
                     true_path.push((t.header.stamp_ns as f64 / 1e9, [p.x_m, p.y_m]));
                     run.last_truth = Some(t);
                 }
-                "ums/map" => run.last_map = Some(harvey_cdr::decode(&m.data).map_err(bad)?),
+                "ums/map" => run.last_map = Some(m.decode()?),
                 "executive/pose" => run.fixes += 1,
                 "executive/behaviour" => {
-                    let b: harvey_msgs::BehaviourState = harvey_cdr::decode(&m.data).map_err(bad)?;
+                    let b: harvey_msgs::BehaviourState = m.decode()?;
                     if run.fsa_trace.last() != Some(&b.fsa_state) {
                         run.fsa_trace.push(b.fsa_state);
                     }
                     run.achieved = b.achieved;
                 }
                 "executive/plan" => {
-                    let p: PlanSketch = harvey_cdr::decode(&m.data).map_err(bad)?;
+                    let p: PlanSketch = m.decode()?;
                     let checks_before = run.last_plan.map_or(0, |q| q.checks);
                     if p.checks > checks_before {
                         let k = match p.last_outcome {
@@ -95,26 +92,18 @@ impl RunStats {
                 _ => {}
             }
         }
-        if let Ok(Some(summary)) = mcap::Summary::read(&bytes) {
-            match harvey_recorder::export::recorded_world(&bytes, &summary) {
-                Ok(Some((w, poles))) => {
-                    if let Some(f) = w.poles.as_ref() {
-                        run.pole_visits = Some((f.first_visits(&poles, &true_path), f.visit_m));
-                    }
+        match recording.world() {
+            Ok(Some((w, poles))) => {
+                if let Some(f) = w.poles.as_ref() {
+                    run.pole_visits = Some((f.first_visits(&poles, &true_path), f.visit_m));
                 }
-                Ok(None) => {}
-                Err(e) => tracing::warn!("{}: {e}; poles not counted", path.display()),
             }
-            for idx in summary.metadata_indexes.iter().filter(|i| i.name == "harvey.recorder") {
-                let md = mcap::read::metadata(&bytes, idx)
-                    .with_context(|| format!("{}: recorder metadata", path.display()))?;
-                for (k, v) in &md.metadata {
-                    if let Some(topic) = k.strip_suffix(".seq_gaps")
-                        && let Some(t) = run.topics.get_mut(topic)
-                    {
-                        t.seq_gaps = v.parse().ok();
-                    }
-                }
+            Ok(None) => {}
+            Err(e) => tracing::warn!("{e}; poles not counted"),
+        }
+        for (topic, gaps) in recording.seq_gaps()? {
+            if let Some(t) = run.topics.get_mut(&topic) {
+                t.seq_gaps = gaps;
             }
         }
         Ok(run)

@@ -11,8 +11,9 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use harvey_bus::Bus;
-use harvey_camera::Renderer;
 use harvey_msgs::{Encoding, FrameHeader, topics};
+use harvey_recording::Recording;
+use harvey_render::Renderer;
 
 const W: u32 = 1920;
 const H: u32 = 1080;
@@ -84,12 +85,14 @@ fn record(dir: &Path, frames: &[Vec<u8>], rate_hz: Option<f64>, seconds: f64, ta
     // SAFETY: kill(2) on our own child: SIGTERM makes it finish the file.
     unsafe { libc::kill(recorder.id() as i32, libc::SIGTERM) };
     recorder.wait().expect("recorder exits");
-    let bytes = std::fs::read(&mcap).expect("recording");
-    let recorded = mcap::MessageStream::new(&bytes)
+    let recording = Recording::open(&mcap).expect("recording");
+    let recorded = recording
+        .messages()
         .expect("mcap")
         .filter_map(Result::ok)
-        .filter(|m| m.channel.topic == "/camera/frame" && m.sequence > 0)
+        .filter(|m| m.topic() == "camera/frame" && m.sequence() > 0)
         .count() as u64;
+    let file_bytes = std::fs::metadata(&mcap).expect("recording").len();
     let _ = std::fs::remove_file(&mcap);
     drop(publisher);
     drop(bus);
@@ -100,7 +103,7 @@ fn record(dir: &Path, frames: &[Vec<u8>], rate_hz: Option<f64>, seconds: f64, ta
         sent,
         recorded,
         mb_s: recorded as f64 * f64::from(W * H * 3) / 1e6 / elapsed,
-        file_mb: bytes.len() as f64 / 1e6,
+        file_mb: file_bytes as f64 / 1e6,
     }
 }
 
@@ -111,7 +114,8 @@ fn main() {
     let frames: Vec<Vec<u8>> = (0..16)
         .map(|i| {
             let mut px = vec![0u8; r.frame_bytes()];
-            r.render(&world, [0.5 * i as f64, 0.1, 0.05 * i as f64], &mut px).expect("render");
+            r.render(&world, harvey_world::Pose2::new(0.5 * i as f64, 0.1, 0.05 * i as f64), &mut px)
+                .expect("render");
             px
         })
         .collect();

@@ -12,8 +12,8 @@ use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waitable, Waiter};
 use harvey_cdr::Ros2Msg;
 use harvey_msgs::{Message, Topic, topics};
-use harvey_recorder::rrd::RrdWriter;
-use harvey_recorder::{Recorder, data_files};
+use harvey_recording::rrd::RrdWriter;
+use harvey_recording::{Recorder, data_files};
 
 mod taps;
 mod writer;
@@ -64,7 +64,7 @@ fn main() -> anyhow::Result<()> {
                 std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
             let name = path.file_name().map_or("world.toml".into(), |n| n.to_string_lossy().into_owned());
             let mut world = harvey_world::load_str(&text, &path.display().to_string())?;
-            world.place_poles(args.seed).map_err(anyhow::Error::msg)?;
+            world.place_poles(args.seed)?;
             rec.attach_world(&name, &text, args.seed)?;
             Some(world)
         }
@@ -75,7 +75,7 @@ fn main() -> anyhow::Result<()> {
         let name = path.file_name().map_or("launch.toml".into(), |n| n.to_string_lossy().into_owned());
         rec.attach_launch(&name, &text)?;
         let base = path.parent().unwrap_or(std::path::Path::new("."));
-        for file in data_files::named_in(&text, &path.display().to_string()).map_err(anyhow::Error::msg)? {
+        for file in data_files::named_in(&text, &path.display().to_string())? {
             let at = base.join(&file);
             let bytes = std::fs::read(&at).with_context(|| format!("reading {}", at.display()))?;
             rec.attach_data(&file, &bytes)?;

@@ -4,7 +4,7 @@
 use harvey_bus::{FrameSubscriber, Subscriber, Waitable};
 use harvey_cdr::{Ros2Msg, encode, encode_image};
 use harvey_msgs::Message;
-use harvey_recorder::Channel;
+use harvey_recording::Channel;
 
 /// One message on its way to the files.
 pub struct Item {

@@ -6,9 +6,9 @@ use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, SyncSender, sync_chann
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use harvey_recorder::export::draw_recorded;
-use harvey_recorder::rrd::RrdWriter;
-use harvey_recorder::{ChannelStats, Recorder};
+use harvey_recording::draw::draw_recorded;
+use harvey_recording::rrd::RrdWriter;
+use harvey_recording::{ChannelStats, Recorder};
 
 use crate::taps::Batch;
 

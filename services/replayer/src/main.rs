@@ -1,5 +1,11 @@
 //! harvey-replayer: the clock master of a replay. It publishes a recording's inputs one tick at
 //! a time, each once every service has finished the previous tick (`harvey replay` launches it).
+//!
+//! A run's inputs are what came from outside the software under test: the simulator's truth,
+//! the DRV's raw reports and the camera's frames (`harvey_recording::ticks`). `harvey replay`
+//! runs every other service again and this replayer, as clock master, hands them the recorded
+//! inputs one tick at a time, just as the bridge did live. In deterministic mode every party saw
+//! each tick's inputs at its turn, so the services publish again exactly what they published then.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -8,7 +14,8 @@ use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, Lockstep, Waiter, Wake};
 use harvey_msgs::topics;
-use harvey_replayer::{Input, for_each_tick};
+use harvey_recording::Recording;
+use harvey_recording::ticks::{Input, for_each_tick};
 
 #[derive(Parser)]
 #[command(
@@ -51,11 +58,9 @@ fn wait_for(
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
-    let bytes =
-        std::fs::read(&args.recording).with_context(|| format!("reading {}", args.recording.display()))?;
-    let err = |e: anyhow::Error| e.context(args.recording.display().to_string());
+    let recording = Recording::open(&args.recording)?;
     // A first pass checks the whole recording before any service sees it, and sizes the frames.
-    let contents = for_each_tick(&bytes, |_, _| Ok(())).map_err(err)?;
+    let contents = for_each_tick::<anyhow::Error>(&recording, |_, _| Ok(()))?;
     anyhow::ensure!(contents.ticks > 0, "{}: holds no inputs to replay", args.recording.display());
 
     let bus = Bus::join("replayer")?;
@@ -85,7 +90,7 @@ fn main() -> anyhow::Result<()> {
     let started = Instant::now();
     let mut previous = None;
     let mut interrupted = false;
-    for_each_tick(&bytes, |stamp, inputs| {
+    for_each_tick(&recording, |stamp, inputs| {
         if interrupted || !wait_for(&lockstep, &waiter, &mut done, previous, stall)? {
             interrupted = true;
             return Ok(());
@@ -117,7 +122,7 @@ fn main() -> anyhow::Result<()> {
         previous = Some(stamp);
         Ok(())
     })
-    .map_err(err)?;
+    .with_context(|| args.recording.display().to_string())?;
     if interrupted || !wait_for(&lockstep, &waiter, &mut done, previous, stall)? {
         tracing::warn!("replay interrupted");
         return Ok(());

@@ -1,4 +1,4 @@
-//! The recorder's logic: an MCAP file with the ROS 2 conventions (profile `ros2`, `ros2msg`
+//! The MCAP writer of a recording, with the ROS 2 conventions (profile `ros2`, `ros2msg`
 //! schemas with their dependencies, `cdr` payloads, `offered_qos_profiles` channel metadata).
 //! Log times are the messages' own stamps, never the recorder's clock, so a deterministic run
 //! records the same bytes every time.
@@ -8,38 +8,19 @@ use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
-pub mod compare;
-pub mod data_files;
-pub mod draw;
-pub mod export;
-pub mod recover;
-pub mod rrd;
-
 use harvey_cdr::{Def, Ros2Msg, encode, encode_image, full_text, image_def};
 use harvey_msgs::FrameHeader;
 use mcap::records::{MessageHeader, Metadata};
 
+use crate::{
+    LAUNCH_MEDIA_TYPE, RECORDER_METADATA, RecordingError, WORLD_MEDIA_TYPE, WORLD_METADATA, data_files,
+};
+
 /// QoS that ROS 2 tools expect on a channel: reliable, volatile, keep-last 16 (rosbag2's YAML).
 const QOS_YAML: &str = "- history: 1\n  depth: 16\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 2147483647\n    nsec: 4294967295\n  lifespan:\n    sec: 2147483647\n    nsec: 4294967295\n  liveliness: 1\n  liveliness_lease_duration:\n    sec: 2147483647\n    nsec: 4294967295\n  avoid_ros_namespace_conventions: false";
 
-/// Media type of the world file attached to a recording.
-pub const WORLD_MEDIA_TYPE: &str = "application/toml; harvey-world";
-/// Name of the metadata record that goes with the world attachment: its file name and the seed.
-pub const WORLD_METADATA: &str = "harvey.world";
-/// Media type of the launch file (services and mission) attached to a recording: what
-/// `harvey replay` runs again.
-pub const LAUNCH_MEDIA_TYPE: &str = "application/toml; harvey-launch";
-
 /// MCAP's chunk size: large enough to compress well, small enough to bound a crash's loss.
 const CHUNK_BYTES: u64 = 4 << 20;
-
-/// A failure of the recording, naming the file.
-#[derive(Debug, thiserror::Error)]
-#[error("recording {file}: {detail}")]
-pub struct RecordError {
-    pub file: PathBuf,
-    pub detail: String,
-}
 
 /// One recorded channel and what went through it.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -64,24 +45,24 @@ pub struct Recorder {
 pub struct Channel(usize);
 
 impl Recorder {
-    pub fn create(path: &Path) -> Result<Self, RecordError> {
-        let err = |detail: String| RecordError { file: path.to_owned(), detail };
-        let file = File::create(path).map_err(|e| err(e.to_string()))?;
+    pub fn create(path: &Path) -> Result<Self, RecordingError> {
+        let file =
+            File::create(path).map_err(|cause| RecordingError::Create { file: path.to_owned(), cause })?;
         let writer = mcap::WriteOptions::new()
             .profile("ros2")
             .library(concat!("harvey-recorder ", env!("CARGO_PKG_VERSION")))
             .compression(Some(mcap::Compression::Zstd))
             .chunk_size(Some(CHUNK_BYTES))
             .create(BufWriter::new(file))
-            .map_err(|e| err(e.to_string()))?;
+            .map_err(|cause| RecordingError::Write { file: path.to_owned(), cause })?;
         Ok(Self { path: path.to_owned(), writer, channels: Vec::new(), scratch: Vec::new() })
     }
 
-    fn err(&self, e: impl std::fmt::Display) -> RecordError {
-        RecordError { file: self.path.clone(), detail: e.to_string() }
+    fn err(&self, cause: mcap::McapError) -> RecordingError {
+        RecordingError::Write { file: self.path.clone(), cause }
     }
 
-    fn add_channel(&mut self, topic: &str, def: &Def) -> Result<Channel, RecordError> {
+    fn add_channel(&mut self, topic: &str, def: &Def) -> Result<Channel, RecordingError> {
         let schema = self
             .writer
             .add_schema(&def.schema_name(), "ros2msg", full_text(def).as_bytes())
@@ -96,16 +77,16 @@ impl Recorder {
     }
 
     /// A channel for a topic of `T`.
-    pub fn channel<T: Ros2Msg>(&mut self, topic: &str) -> Result<Channel, RecordError> {
+    pub fn channel<T: Ros2Msg>(&mut self, topic: &str) -> Result<Channel, RecordingError> {
         self.add_channel(topic, T::DEF)
     }
 
     /// A channel of `sensor_msgs/msg/Image` for a frame topic.
-    pub fn image_channel(&mut self, topic: &str) -> Result<Channel, RecordError> {
+    pub fn image_channel(&mut self, topic: &str) -> Result<Channel, RecordingError> {
         self.add_channel(topic, image_def())
     }
 
-    fn write(&mut self, ch: Channel, seq: u64, stamp_ns: u64) -> Result<(), RecordError> {
+    fn write(&mut self, ch: Channel, seq: u64, stamp_ns: u64) -> Result<(), RecordingError> {
         let data = std::mem::take(&mut self.scratch);
         let result = self.record_encoded(ch, seq, stamp_ns, &data);
         self.scratch = data;
@@ -119,7 +100,7 @@ impl Recorder {
         seq: u64,
         stamp_ns: u64,
         data: &[u8],
-    ) -> Result<(), RecordError> {
+    ) -> Result<(), RecordingError> {
         let (id, stats) = &mut self.channels[ch.0];
         if let Some(last) = stats.last_seq {
             stats.seq_gaps += seq.saturating_sub(last + 1);
@@ -140,20 +121,25 @@ impl Recorder {
         &mut self,
         ch: Channel,
         msg: &T,
-    ) -> Result<(), RecordError> {
+    ) -> Result<(), RecordingError> {
         self.scratch = encode(msg, std::mem::take(&mut self.scratch));
         let h = *msg.header();
         self.write(ch, h.seq, h.stamp_ns)
     }
 
-    pub fn record_frame(&mut self, ch: Channel, h: &FrameHeader, pixels: &[u8]) -> Result<(), RecordError> {
+    pub fn record_frame(
+        &mut self,
+        ch: Channel,
+        h: &FrameHeader,
+        pixels: &[u8],
+    ) -> Result<(), RecordingError> {
         self.scratch = encode_image(h, pixels, std::mem::take(&mut self.scratch));
         self.write(ch, h.seq, h.stamp_ns)
     }
 
     /// Stores the world file the run used and the run's seed (a `harvey.world` metadata record;
     /// it places the world's `[poles]`), so that offline tools (`harvey export`) can draw it.
-    pub fn attach_world(&mut self, name: &str, text: &str, seed: u64) -> Result<(), RecordError> {
+    pub fn attach_world(&mut self, name: &str, text: &str, seed: u64) -> Result<(), RecordingError> {
         self.attach(name, WORLD_MEDIA_TYPE, text)?;
         let metadata =
             BTreeMap::from([("file".to_owned(), name.to_owned()), ("seed".to_owned(), seed.to_string())]);
@@ -162,17 +148,17 @@ impl Recorder {
     }
 
     /// Stores the launch file of the run, so that `harvey replay` can run its services again.
-    pub fn attach_launch(&mut self, name: &str, text: &str) -> Result<(), RecordError> {
+    pub fn attach_launch(&mut self, name: &str, text: &str) -> Result<(), RecordingError> {
         self.attach(name, LAUNCH_MEDIA_TYPE, text)
     }
 
     /// Stores a data file the launch names (`data_files.rs`), under its path relative to the
     /// launch file.
-    pub fn attach_data(&mut self, name: &str, bytes: &[u8]) -> Result<(), RecordError> {
+    pub fn attach_data(&mut self, name: &str, bytes: &[u8]) -> Result<(), RecordingError> {
         self.attach(name, data_files::DATA_MEDIA_TYPE, bytes)
     }
 
-    fn attach(&mut self, name: &str, media_type: &str, data: impl AsRef<[u8]>) -> Result<(), RecordError> {
+    fn attach(&mut self, name: &str, media_type: &str, data: impl AsRef<[u8]>) -> Result<(), RecordingError> {
         let a = mcap::Attachment {
             log_time: 0,
             create_time: 0,
@@ -184,7 +170,7 @@ impl Recorder {
     }
 
     /// Ends the current chunk and pushes it to the file: what is recorded so far survives a crash.
-    pub fn flush(&mut self) -> Result<(), RecordError> {
+    pub fn flush(&mut self) -> Result<(), RecordingError> {
         self.writer.flush().map_err(|e| self.err(e))
     }
 
@@ -193,13 +179,13 @@ impl Recorder {
     }
 
     /// Writes the per-topic counts as a `harvey.recorder` metadata record and the summary.
-    pub fn finish(mut self) -> Result<Vec<ChannelStats>, RecordError> {
+    pub fn finish(mut self) -> Result<Vec<ChannelStats>, RecordingError> {
         let mut metadata = BTreeMap::new();
         for (_, s) in &self.channels {
             metadata.insert(format!("{}.messages", s.topic), s.messages.to_string());
             metadata.insert(format!("{}.seq_gaps", s.topic), s.seq_gaps.to_string());
         }
-        let record = Metadata { name: "harvey.recorder".into(), metadata };
+        let record = Metadata { name: RECORDER_METADATA.into(), metadata };
         self.writer.write_metadata(&record).map_err(|e| self.err(e))?;
         self.writer.finish().map_err(|e| self.err(e))?;
         Ok(self.channels.into_iter().map(|(_, s)| s).collect())

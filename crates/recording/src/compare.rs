@@ -4,6 +4,8 @@
 
 use std::path::Path;
 
+use crate::{Recording, RecordingError};
+
 /// Where two recordings first part ways.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Difference {
@@ -30,22 +32,21 @@ pub struct Record {
 
 /// Every message of `path` whose topic `keep` accepts, in file order. A truncated or corrupt
 /// file is an error naming it.
-pub fn read_records(path: &Path, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Vec<Record>> {
-    let bytes = std::fs::read(path).map_err(|e| anyhow::anyhow!("reading {}: {e}", path.display()))?;
-    let stream = mcap::MessageStream::new(&bytes).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+pub fn read_records(path: &Path, keep: &dyn Fn(&str) -> bool) -> Result<Vec<Record>, RecordingError> {
+    let recording = Recording::open(path)?;
     let mut out = Vec::new();
-    for m in stream {
-        let m = m.map_err(|e| anyhow::anyhow!("{}: after {} messages: {e}", path.display(), out.len()))?;
-        let topic = m.channel.topic.trim_start_matches('/');
-        if keep(topic) {
-            out.push(Record { topic: topic.to_owned(), log_time: m.log_time, data: m.data.into_owned() });
+    for m in recording.messages()? {
+        let m = m?;
+        if keep(m.topic()) {
+            let (topic, log_time) = (m.topic().to_owned(), m.log_time());
+            out.push(Record { topic, log_time, data: m.into_data() });
         }
     }
     Ok(out)
 }
 
 /// Compares the messages of `a` and `b` on the topics `keep` accepts.
-pub fn compare(a: &Path, b: &Path, keep: &dyn Fn(&str) -> bool) -> anyhow::Result<Comparison> {
+pub fn compare(a: &Path, b: &Path, keep: &dyn Fn(&str) -> bool) -> Result<Comparison, RecordingError> {
     let (ra, rb) = (read_records(a, keep)?, read_records(b, keep)?);
     Ok(Comparison { messages: ra.len(), first_difference: first_difference(&ra, &rb) })
 }

@@ -14,18 +14,30 @@ pub fn is_plain_relative(name: &str) -> bool {
     !name.is_empty() && Path::new(name).components().all(|c| matches!(c, Component::Normal(_)))
 }
 
+/// A launch file's `[launch] files` that cannot be taken.
+#[derive(Debug, thiserror::Error)]
+pub enum DataFilesError {
+    /// The launch file is not TOML.
+    #[error("{file}: {cause}")]
+    Toml { file: String, cause: toml::de::Error },
+    #[error("{file}: `launch.files` is not a list")]
+    NotAList { file: String },
+    /// An entry that is not a string, or a path that leaves the launch file's folder.
+    #[error("{file}: `launch.files`: {value} is not a relative path inside the launch's folder")]
+    Escapes { file: String, value: toml::Value },
+}
+
 /// The `[launch] files` of launch file `file` (its text), checked to be plain relative paths.
-pub fn named_in(text: &str, file: &str) -> Result<Vec<String>, String> {
-    let doc: toml::Table = text.parse().map_err(|e| format!("{file}: {e}"))?;
+pub fn named_in(text: &str, file: &str) -> Result<Vec<String>, DataFilesError> {
+    let doc: toml::Table =
+        text.parse().map_err(|cause| DataFilesError::Toml { file: file.to_owned(), cause })?;
     let Some(files) = doc.get("launch").and_then(|l| l.get("files")) else { return Ok(Vec::new()) };
-    let files = files.as_array().ok_or(format!("{file}: `launch.files` is not a list"))?;
+    let files = files.as_array().ok_or_else(|| DataFilesError::NotAList { file: file.to_owned() })?;
     files
         .iter()
         .map(|v| match v.as_str() {
             Some(name) if is_plain_relative(name) => Ok(name.to_owned()),
-            _ => {
-                Err(format!("{file}: `launch.files`: {v} is not a relative path inside the launch's folder"))
-            }
+            _ => Err(DataFilesError::Escapes { file: file.to_owned(), value: v.clone() }),
         })
         .collect()
 }
@@ -43,9 +55,9 @@ mod tests {
             assert!(!is_plain_relative(bad), "{bad}");
         }
         let text = "[launch]\nname = \"d\"\nfiles = [\"fsa/docking.toml\"]\n";
-        assert_eq!(named_in(text, "d.toml"), Ok(vec!["fsa/docking.toml".to_owned()]));
-        assert_eq!(named_in("[launch]\nname = \"d\"\n", "d.toml"), Ok(Vec::new()));
-        let e = named_in("[launch]\nfiles = [\"../up.toml\"]\n", "d.toml").expect_err("escapes");
+        assert_eq!(named_in(text, "d.toml").expect("names"), ["fsa/docking.toml"]);
+        assert_eq!(named_in("[launch]\nname = \"d\"\n", "d.toml").expect("none"), Vec::<String>::new());
+        let e = named_in("[launch]\nfiles = [\"../up.toml\"]\n", "d.toml").expect_err("escapes").to_string();
         assert!(e.contains("d.toml") && e.contains("../up.toml"), "{e}");
     }
 }

@@ -3,11 +3,10 @@
 
 use harvey_msgs::{VisionAlgorithm, VisionResult, VisionStatus};
 
-use super::RrdWriter;
-use crate::RecordError;
+use super::{RrdError, RrdWriter};
 
 impl RrdWriter {
-    pub fn vision_result(&mut self, r: &VisionResult) -> Result<(), RecordError> {
+    pub fn vision_result(&mut self, r: &VisionResult) -> Result<(), RrdError> {
         self.at(r.header.stamp_ns);
         let path = format!("camera/image/vision/{}", r.request_id);
         let items = &r.items[..(r.count as usize).min(r.items.len())];

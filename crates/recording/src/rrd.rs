@@ -7,7 +7,7 @@
 
 mod executive;
 mod vision;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use harvey_msgs::{
     Detections, Expectation, FrameHeader, LandmarkSighting, MissionStatus, MotionCommand, Odometry,
@@ -16,7 +16,16 @@ use harvey_msgs::{
 use harvey_world::World;
 use rerun::blueprint::{Blueprint, Horizontal, Spatial2DView, TextLogView, TimeSeriesView, Vertical};
 
-use crate::RecordError;
+/// A failure of the Rerun file, naming it.
+#[derive(Debug, thiserror::Error)]
+pub enum RrdError {
+    /// The SDK could not create the file or log to it.
+    #[error("recording {file}: {cause}")]
+    Log { file: PathBuf, cause: rerun::RecordingStreamError },
+    /// What is logged could not be pushed to the file.
+    #[error("recording {file}: {cause}")]
+    Flush { file: PathBuf, cause: rerun::sink::SinkFlushError },
+}
 
 fn up(p: [f64; 2]) -> [f32; 2] {
     [p[0] as f32, -p[1] as f32]
@@ -37,7 +46,7 @@ fn pose_arrow(p: &harvey_msgs::Pose2, colour: rerun::Color) -> rerun::Arrows2D {
 /// An open `.rrd` file.
 pub struct RrdWriter {
     rec: rerun::RecordingStream,
-    path: String,
+    path: PathBuf,
     pose: Option<[f64; 3]>,
     last_state: Option<(u32, u32, u32)>,
     /// The executive's current goal: the line the servo deviation is measured from.
@@ -57,8 +66,7 @@ const WINDOW_LIFETIME_NS: u64 = 300_000_000;
 
 impl RrdWriter {
     /// Creates the file with Harvey's blueprint, and draws the world's walls and landmarks.
-    pub fn create(path: &Path, world: Option<&World>) -> Result<Self, RecordError> {
-        let err = |e: &dyn std::fmt::Display| RecordError { file: path.to_owned(), detail: e.to_string() };
+    pub fn create(path: &Path, world: Option<&World>) -> Result<Self, RrdError> {
         let blueprint = Blueprint::new(Horizontal::new([
             Vertical::new([
                 Spatial2DView::new("camera").with_origin("/camera").into(),
@@ -74,12 +82,12 @@ impl RrdWriter {
         let rec = rerun::RecordingStreamBuilder::new("harvey")
             .with_blueprint(blueprint)
             .save(path)
-            .map_err(|e| err(&e))?;
+            .map_err(|cause| RrdError::Log { file: path.to_owned(), cause })?;
         let camera =
             world.map(|w| (w.camera.focal_px, f64::from(w.camera.width_px), f64::from(w.camera.height_px)));
         let mut w = Self {
             rec,
-            path: path.display().to_string(),
+            path: path.to_owned(),
             pose: None,
             last_state: None,
             goal: None,
@@ -94,15 +102,15 @@ impl RrdWriter {
         Ok(w)
     }
 
-    fn err(&self, e: impl std::fmt::Display) -> RecordError {
-        RecordError { file: self.path.clone().into(), detail: e.to_string() }
+    fn err(&self, cause: rerun::RecordingStreamError) -> RrdError {
+        RrdError::Log { file: self.path.clone(), cause }
     }
 
     fn at(&self, stamp_ns: u64) {
         self.rec.set_duration_secs("sim_time", stamp_ns as f64 / 1e9);
     }
 
-    fn draw_world(&mut self, world: &World) -> Result<(), RecordError> {
+    fn draw_world(&mut self, world: &World) -> Result<(), RrdError> {
         let walls: Vec<Vec<[f32; 2]>> = world.walls.iter().map(|w| vec![up(w.from), up(w.to)]).collect();
         let grey = rerun::Color::from_rgb(170, 170, 170);
         self.rec
@@ -119,7 +127,7 @@ impl RrdWriter {
         self.rec.log_static("world/landmarks", &landmarks).map_err(|e| self.err(e))
     }
 
-    pub fn truth(&mut self, m: &TruePose) -> Result<(), RecordError> {
+    pub fn truth(&mut self, m: &TruePose) -> Result<(), RrdError> {
         self.at(m.header.stamp_ns);
         let arrow = pose_arrow(&m.world_from_robot, rerun::Color::from_rgb(60, 200, 60));
         self.rec.log("world/truth", &arrow).map_err(|e| self.err(e))?;
@@ -132,12 +140,12 @@ impl RrdWriter {
     }
 
     /// Deterministic mode: the wall time every service together took for the tick at `stamp_ns`.
-    pub fn loop_latency(&mut self, stamp_ns: u64, wall_ms: f64) -> Result<(), RecordError> {
+    pub fn loop_latency(&mut self, stamp_ns: u64, wall_ms: f64) -> Result<(), RrdError> {
         self.at(stamp_ns);
         self.rec.log("plots/loop_latency_ms", &rerun::Scalars::single(wall_ms)).map_err(|e| self.err(e))
     }
 
-    pub fn odometry(&mut self, m: &Odometry) -> Result<(), RecordError> {
+    pub fn odometry(&mut self, m: &Odometry) -> Result<(), RrdError> {
         self.at(m.header.stamp_ns);
         let p = m.world_from_robot;
         self.pose = Some([p.x_m, p.y_m, p.heading_rad]);
@@ -146,7 +154,7 @@ impl RrdWriter {
     }
 
     /// Sonar returns, placed in the world from the latest odometry pose.
-    pub fn sonar(&mut self, m: &SonarRing) -> Result<(), RecordError> {
+    pub fn sonar(&mut self, m: &SonarRing) -> Result<(), RrdError> {
         let Some([x, y, th]) = self.pose else { return Ok(()) };
         self.at(m.header.stamp_ns);
         let pts: Vec<[f32; 2]> = (0..m.range_m.len())
@@ -168,7 +176,7 @@ impl RrdWriter {
     }
 
     /// The uncertainty polygon, the heading wedge (two rays from the centre) and the area plot.
-    pub fn map(&mut self, m: &UncertaintyMap) -> Result<(), RecordError> {
+    pub fn map(&mut self, m: &UncertaintyMap) -> Result<(), RrdError> {
         self.at(m.header.stamp_ns);
         let n = m.vertex_count as usize;
         let mut ring: Vec<[f32; 2]> = m.vertices_m[..n].iter().map(|v| up(*v)).collect();
@@ -207,7 +215,7 @@ impl RrdWriter {
         self.rec.log("plots/heading_wedge_deg", &rerun::Scalars::single(wedge_deg)).map_err(|e| self.err(e))
     }
 
-    pub fn frame(&mut self, h: &FrameHeader, pixels: &[u8]) -> Result<(), RecordError> {
+    pub fn frame(&mut self, h: &FrameHeader, pixels: &[u8]) -> Result<(), RrdError> {
         self.at(h.stamp_ns);
         self.rec.set_time_sequence("frame", h.seq as i64);
         let size = [h.width_px, h.height_px];
@@ -218,7 +226,7 @@ impl RrdWriter {
         self.rec.log("camera/image", &image).map_err(|e| self.err(e))
     }
 
-    pub fn expectation(&mut self, e: &Expectation) -> Result<(), RecordError> {
+    pub fn expectation(&mut self, e: &Expectation) -> Result<(), RrdError> {
         self.at(e.header.stamp_ns);
         self.windows.insert(e.landmark_index, e.header.stamp_ns);
         let [u0, v0, u1, v1] = e.window_px;
@@ -230,7 +238,7 @@ impl RrdWriter {
     }
 
     /// A recognised landmark: a vertical line at its bearing's column (for class I and II).
-    pub fn sighting(&mut self, s: &LandmarkSighting) -> Result<(), RecordError> {
+    pub fn sighting(&mut self, s: &LandmarkSighting) -> Result<(), RrdError> {
         let Some((f, w, h)) = self.camera else { return Ok(()) };
         self.at(s.header.stamp_ns);
         if s.kind == 1 || s.kind == 2 {
@@ -245,7 +253,7 @@ impl RrdWriter {
     }
 
     /// A vision worker's features, as points on the image.
-    pub fn detections(&mut self, d: &Detections) -> Result<(), RecordError> {
+    pub fn detections(&mut self, d: &Detections) -> Result<(), RrdError> {
         self.at(d.header.stamp_ns);
         let n = (d.count as usize).min(d.features.len());
         let pts: Vec<[f32; 2]> = d.features[..n].iter().map(|f| [f.x_px, f.y_px]).collect();
@@ -259,7 +267,7 @@ impl RrdWriter {
             .map_err(|e| self.err(e))
     }
 
-    pub fn command(&mut self, c: &MotionCommand) -> Result<(), RecordError> {
+    pub fn command(&mut self, c: &MotionCommand) -> Result<(), RrdError> {
         self.at(c.header.stamp_ns);
         let text = format!(
             "command {}: kind {} distance {:.3} m angle {:.1} deg{}",
@@ -275,7 +283,7 @@ impl RrdWriter {
     }
 
     /// The executive's status, logged when its state or step changes.
-    pub fn status(&mut self, s: &MissionStatus) -> Result<(), RecordError> {
+    pub fn status(&mut self, s: &MissionStatus) -> Result<(), RrdError> {
         self.goal = Some(s.goal);
         if self.last_state == Some((s.state, s.step, s.servo)) {
             return Ok(());
@@ -295,12 +303,12 @@ impl RrdWriter {
     }
 
     /// Pushes what is logged so far to the file.
-    pub fn flush(&self) -> Result<(), RecordError> {
-        self.rec.flush_blocking().map_err(|e| self.err(e))
+    pub fn flush(&self) -> Result<(), RrdError> {
+        self.rec.flush_blocking().map_err(|cause| RrdError::Flush { file: self.path.clone(), cause })
     }
 
     /// Flushes and closes the file (the footer is written when the stream drops).
-    pub fn finish(self) -> Result<(), RecordError> {
+    pub fn finish(self) -> Result<(), RrdError> {
         self.flush()?;
         drop(self.rec);
         Ok(())

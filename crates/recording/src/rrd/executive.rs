@@ -7,11 +7,10 @@
 
 use harvey_msgs::{BehaviourState, CheckOutcome, PlanSketch, PoseFix, ServoCorrection};
 
-use super::RrdWriter;
-use crate::RecordError;
+use super::{RrdError, RrdWriter};
 
 impl RrdWriter {
-    pub fn servo(&mut self, c: &ServoCorrection) -> Result<(), RecordError> {
+    pub fn servo(&mut self, c: &ServoCorrection) -> Result<(), RrdError> {
         self.at(c.header.stamp_ns);
         for (path, v) in [
             ("plots/servo_heading_error_deg", c.heading_error_rad.to_degrees()),
@@ -34,7 +33,7 @@ impl RrdWriter {
             .map_err(|e| self.err(e))
     }
 
-    pub fn pose_fix(&mut self, p: &PoseFix) -> Result<(), RecordError> {
+    pub fn pose_fix(&mut self, p: &PoseFix) -> Result<(), RrdError> {
         self.at(p.header.stamp_ns);
         let expected = super::pose_arrow(&p.expected, rerun::Color::from_rgb(200, 120, 40));
         self.rec.log("world/pose_fix/expected", &expected).map_err(|e| self.err(e))?;
@@ -57,7 +56,7 @@ impl RrdWriter {
             .map_err(|e| self.err(e))
     }
 
-    pub fn plan(&mut self, p: &PlanSketch) -> Result<(), RecordError> {
+    pub fn plan(&mut self, p: &PlanSketch) -> Result<(), RrdError> {
         self.at(p.header.stamp_ns);
         let n = (p.place_count as usize).min(harvey_msgs::SKETCH_PLACES);
         let places: Vec<[f32; 2]> =
@@ -101,7 +100,7 @@ impl RrdWriter {
         self.rec.log("log", &rerun::TextLog::new(text).with_level(level)).map_err(|e| self.err(e))
     }
 
-    pub fn behaviour(&mut self, b: &BehaviourState) -> Result<(), RecordError> {
+    pub fn behaviour(&mut self, b: &BehaviourState) -> Result<(), RrdError> {
         self.at(b.header.stamp_ns);
         self.rec
             .log("plots/fsa_state", &rerun::Scalars::single(f64::from(b.fsa_state)))

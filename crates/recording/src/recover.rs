@@ -11,7 +11,7 @@ use enumset::EnumSet;
 use mcap::read::Options;
 use mcap::records::{Metadata, Record};
 
-use crate::RecordError;
+use crate::{RECOVER_METADATA, Recording, RecordingError};
 
 /// What was salvaged.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -23,19 +23,19 @@ pub struct Salvage {
 }
 
 /// Copies what can be read of `input` into a new, complete MCAP file at `output`.
-pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordError> {
-    let err = |detail: String| RecordError { file: input.to_owned(), detail };
-    let bytes = std::fs::read(input).map_err(|e| err(e.to_string()))?;
+pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordingError> {
+    let recording = Recording::open(input)?;
+    let bytes = recording.bytes();
     if !bytes.starts_with(mcap::MAGIC) {
-        return Err(err("not an MCAP file (no magic bytes at the start)".into()));
+        return Err(RecordingError::NoMagic { file: input.to_owned() });
     }
+    let not_mcap = |cause| RecordingError::NotMcap { file: input.to_owned(), cause };
     let options = EnumSet::only(Options::IgnoreEndMagic);
     let mut profile = String::new();
     let mut attachments = Vec::new();
     let mut metadata = Vec::new();
     let mut stopped_at = None;
-    let linear =
-        mcap::read::LinearReader::new_with_options(&bytes, options).map_err(|e| err(e.to_string()))?;
+    let linear = mcap::read::LinearReader::new_with_options(bytes, options).map_err(not_mcap)?;
     for record in linear {
         match record {
             Ok(Record::Header(h)) => profile = h.profile,
@@ -49,8 +49,8 @@ pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordError> {
         }
     }
     let out =
-        File::create(output).map_err(|e| RecordError { file: output.to_owned(), detail: e.to_string() })?;
-    let oerr = |e: mcap::McapError| RecordError { file: output.to_owned(), detail: e.to_string() };
+        File::create(output).map_err(|cause| RecordingError::Create { file: output.to_owned(), cause })?;
+    let oerr = |cause| RecordingError::Write { file: output.to_owned(), cause };
     let mut w = mcap::WriteOptions::new()
         .profile(&profile)
         .library(concat!("harvey recover ", env!("CARGO_PKG_VERSION")))
@@ -70,7 +70,7 @@ pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordError> {
         w.write_metadata(m).map_err(oerr)?;
     }
     let mut messages = 0;
-    let stream = mcap::MessageStream::new_with_options(&bytes, options).map_err(|e| err(e.to_string()))?;
+    let stream = mcap::MessageStream::new_with_options(bytes, options).map_err(not_mcap)?;
     for m in stream {
         match m {
             Ok(m) => {
@@ -87,7 +87,7 @@ pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordError> {
     md.insert("source".to_owned(), input.display().to_string());
     md.insert("messages".to_owned(), messages.to_string());
     md.insert("stopped_at".to_owned(), stopped_at.clone().unwrap_or_else(|| "end of file".into()));
-    w.write_metadata(&Metadata { name: "harvey.recover".into(), metadata: md }).map_err(oerr)?;
+    w.write_metadata(&Metadata { name: RECOVER_METADATA.into(), metadata: md }).map_err(oerr)?;
     w.finish().map_err(oerr)?;
     Ok(Salvage { messages, attachments: attachments.len() as u64, stopped_at })
 }

@@ -1,0 +1,43 @@
+//! Harvey's MCAP recordings: the one crate that knows how a run is written and read.
+//!
+//! A recording is an MCAP file with the ROS 2 conventions (profile `ros2`, `ros2msg` schemas,
+//! `cdr` payloads), its log times the messages' own stamps. It carries as attachments the world
+//! file of the run (with a `harvey.world` metadata record: its name and the seed that placed its
+//! poles), the launch file and the data files the launch names, so that it replays on its own;
+//! the recorder's per-topic counts are a `harvey.recorder` metadata record.
+//!
+//! [`Recorder`] writes one, [`Recording`] reads one back; [`compare`], [`recover`] and
+//! [`export`] (to a Rerun file, drawn by [`rrd`]) are the offline tools; [`ticks`] splits a
+//! recording's inputs into the ticks a replay feeds.
+
+mod attachments;
+pub mod compare;
+pub mod data_files;
+pub mod draw;
+mod error;
+pub mod export;
+pub mod reader;
+pub mod recover;
+pub mod rrd;
+pub mod ticks;
+pub mod writer;
+
+pub use attachments::DataFile;
+pub use data_files::DATA_MEDIA_TYPE;
+pub use error::RecordingError;
+pub use reader::{Message, Recording};
+pub use writer::{Channel, ChannelStats, Recorder};
+
+/// Media type of the world file attached to a recording.
+pub const WORLD_MEDIA_TYPE: &str = "application/toml; harvey-world";
+/// Name of the metadata record that goes with the world attachment: its file name and the seed.
+pub const WORLD_METADATA: &str = "harvey.world";
+/// Media type of the launch file (services and mission) attached to a recording: what
+/// `harvey replay` runs again.
+pub const LAUNCH_MEDIA_TYPE: &str = "application/toml; harvey-launch";
+/// Name of the metadata record of the recorder's per-topic counts: `<topic>.messages` and
+/// `<topic>.seq_gaps`.
+pub const RECORDER_METADATA: &str = "harvey.recorder";
+/// Name of the metadata record `harvey recover` adds: the source, messages salvaged, where it
+/// stopped.
+pub const RECOVER_METADATA: &str = "harvey.recover";
