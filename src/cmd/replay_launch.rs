@@ -1,14 +1,12 @@
-//! `harvey replay`: runs a recording's services again on its recorded inputs and records them
-//! again. The recording carries its launch, world and data files; the replay launch is that launch
-//! with the input producers (simulated DRV, bridge, camera) replaced by `harvey-replayer` as
-//! clock master.
+//! The launch `harvey replay` runs: a recording carries its launch, world and data files, and
+//! the replay launch is that launch with the input producers (simulated DRV, bridge, camera)
+//! replaced by `harvey-replayer` as clock master.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::Context;
-use harvey_recorder::data_files::{DATA_MEDIA_TYPE, is_plain_relative};
-use harvey_recorder::{LAUNCH_MEDIA_TYPE, WORLD_MEDIA_TYPE};
-use harvey_replayer::INPUT_SERVICES;
+use harvey_recording::Recording;
+use harvey_recording::ticks::INPUT_SERVICES;
 
 /// Name of the replay launch file written into the run folder.
 pub const LAUNCH_FILE: &str = "replay.toml";
@@ -16,40 +14,21 @@ pub const LAUNCH_FILE: &str = "replay.toml";
 /// Writes the replay's launch and world files into `run_dir`; returns the launch file's path.
 pub fn prepare(recording: &Path, run_dir: &Path, rrd: bool) -> anyhow::Result<PathBuf> {
     let name = recording.display().to_string();
-    let bytes = std::fs::read(recording).with_context(|| format!("reading {name}"))?;
-    let summary = mcap::Summary::read(&bytes)
-        .with_context(|| format!("{name}: no readable summary (run `harvey recover` on it first)"))?
-        .with_context(|| format!("{name}: no summary (run `harvey recover` on it first)"))?;
-    let attached = |media_type: &str| -> anyhow::Result<String> {
-        let index =
-            summary.attachment_indexes.iter().find(|a| a.media_type == media_type).with_context(|| {
-                format!("{name}: no `{media_type}` attachment: was it recorded by `harvey run`?")
-            })?;
-        let a = mcap::read::attachment(&bytes, index)
-            .with_context(|| format!("{name}: attachment `{}`", index.name))?;
-        String::from_utf8(a.data.to_vec())
-            .with_context(|| format!("{name}: attachment `{}` is not text", a.name))
-    };
-    let (world, launch) = (attached(WORLD_MEDIA_TYPE)?, attached(LAUNCH_MEDIA_TYPE)?);
+    let rec = Recording::open(recording)?;
+    let (world, launch) = (rec.world_text()?, rec.launch_text()?);
     std::fs::create_dir_all(run_dir).with_context(|| format!("creating {}", run_dir.display()))?;
     let original = std::fs::canonicalize(recording).with_context(|| format!("resolving {name}"))?;
     let output = std::fs::canonicalize(run_dir)?.join("run.mcap");
     anyhow::ensure!(output != original, "the replay would overwrite {name}: choose another --run-dir");
     std::fs::write(run_dir.join("world.toml"), world)?;
     // The launch's data files (acceptor tables...), back beside the replay's launch file.
-    for index in summary.attachment_indexes.iter().filter(|a| a.media_type == DATA_MEDIA_TYPE) {
-        anyhow::ensure!(
-            is_plain_relative(&index.name),
-            "{name}: data attachment `{}` is not a relative path inside the run folder",
-            index.name
-        );
-        let a = mcap::read::attachment(&bytes, index)
-            .with_context(|| format!("{name}: attachment `{}`", index.name))?;
-        let to = run_dir.join(&index.name);
+    for file in rec.data_files()? {
+        let file = file?;
+        let to = run_dir.join(&file.name);
         if let Some(dir) = to.parent() {
             std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         }
-        std::fs::write(&to, &a.data).with_context(|| format!("writing {}", to.display()))?;
+        std::fs::write(&to, &file.data).with_context(|| format!("writing {}", to.display()))?;
     }
     let text =
         replay_launch(&launch, &original, rrd).with_context(|| format!("{name}: attached launch file"))?;
@@ -105,8 +84,8 @@ mod tests {
     fn the_input_services_give_way_to_the_replayer() {
         let text = std::fs::read_to_string("missions/default.toml").expect("default mission");
         let out = replay_launch(&text, Path::new("/r/run.mcap"), false).expect("rewrites");
-        let lf =
-            crate::launch::LaunchFile::parse(&out, Path::new("replay.toml")).expect("a valid launch file");
+        let lf = harvey_supervisor::LaunchFile::parse(&out, Path::new("replay.toml"))
+            .expect("a valid launch file");
         let names: Vec<&str> = lf.services.iter().map(|s| s.name()).collect();
         assert_eq!(
             names,

@@ -2,24 +2,53 @@
 //! fd 3, its output prefixed with its name, stopped with SIGTERM then SIGKILL, always reaped.
 
 use std::io::{BufRead, BufReader, Read};
-use std::os::fd::{AsRawFd, OwnedFd};
+use std::os::fd::{AsFd, AsRawFd, BorrowedFd, OwnedFd};
 use std::os::unix::process::{CommandExt, ExitStatusExt};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
-use anyhow::Context;
-use nix::poll::{PollFd, PollFlags, PollTimeout, poll};
+use nix::errno::Errno;
 use nix::sys::signal::{Signal, kill};
 use nix::unistd::Pid;
 
+use crate::wait::{NotReady, pidfd, poll_input, wait_ready};
+
 /// The fd number a child finds its readiness pipe on.
 const READY_FD: i32 = 3;
+
+/// How often a child without a pidfd is checked while it is being stopped.
+const EXIT_POLL: Duration = Duration::from_millis(10);
+
+/// A child that could not be started.
+#[derive(Debug, thiserror::Error)]
+pub enum SpawnError {
+    #[error("creating a readiness pipe")]
+    Pipe(#[source] Errno),
+    #[error("service `{service}`: cannot start {}", binary.display())]
+    Start {
+        service: String,
+        binary: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("service `{service}` did not become ready: {why} (then {status})")]
+    NotReady { service: String, why: NotReady, status: String },
+}
 
 /// A running child.
 pub struct Running {
     pub name: String,
     pub child: Child,
+    /// Its pidfd, readable once it has exited; `None` on kernels without pidfds.
+    exited: Option<OwnedFd>,
+}
+
+impl Running {
+    /// A descriptor that becomes readable when the child exits, if the kernel has pidfds.
+    pub fn exit_fd(&self) -> Option<BorrowedFd<'_>> {
+        self.exited.as_ref().map(|fd| fd.as_fd())
+    }
 }
 
 /// How a child ended.
@@ -50,9 +79,9 @@ pub fn spawn(
     args: &[String],
     env: &[(&str, String)],
     ready_timeout: Duration,
-) -> anyhow::Result<Running> {
+) -> Result<Running, SpawnError> {
     let (ready_read, ready_write): (OwnedFd, OwnedFd) =
-        nix::unistd::pipe2(nix::fcntl::OFlag::O_CLOEXEC).context("creating a readiness pipe")?;
+        nix::unistd::pipe2(nix::fcntl::OFlag::O_CLOEXEC).map_err(SpawnError::Pipe)?;
     let write_raw = ready_write.as_raw_fd();
     let mut cmd = Command::new(binary);
     cmd.args(args)
@@ -75,8 +104,11 @@ pub fn spawn(
             Ok(())
         });
     }
-    let mut child =
-        cmd.spawn().with_context(|| format!("service `{name}`: cannot start {}", binary.display()))?;
+    let mut child = cmd.spawn().map_err(|source| SpawnError::Start {
+        service: name.to_owned(),
+        binary: binary.to_owned(),
+        source,
+    })?;
     drop(ready_write);
     if let Some(out) = child.stdout.take() {
         forward_lines(name.to_owned(), out);
@@ -84,48 +116,16 @@ pub fn spawn(
     if let Some(err) = child.stderr.take() {
         forward_lines(name.to_owned(), err);
     }
-    let mut running = Running { name: name.to_owned(), child };
+    // Not yet reaped (only we wait for it), so the pid cannot name another process.
+    let exited = pidfd(child.id());
+    let mut running = Running { name: name.to_owned(), child, exited };
     match wait_ready(&ready_read, ready_timeout) {
         Ok(()) => Ok(running),
         Err(why) => {
             let status = stop(&mut running, Duration::from_millis(500));
-            anyhow::bail!("service `{name}` did not become ready: {why} (then {})", describe(status))
+            Err(SpawnError::NotReady { service: name.to_owned(), why, status: describe(status) })
         }
     }
-}
-
-fn wait_ready(pipe: &OwnedFd, timeout: Duration) -> Result<(), String> {
-    let deadline = Instant::now() + timeout;
-    let mut got = Vec::new();
-    loop {
-        let left = deadline.saturating_duration_since(Instant::now());
-        if left.is_zero() {
-            return Err(format!("no readiness within {} ms", timeout.as_millis()));
-        }
-        let mut fds = [PollFd::new(pipe_fd(pipe), PollFlags::POLLIN)];
-        let ms = PollTimeout::try_from(left.as_millis().min(60_000) as i32).unwrap_or(PollTimeout::MAX);
-        match poll(&mut fds, ms) {
-            Ok(0) => continue,
-            Ok(_) => {}
-            Err(nix::errno::Errno::EINTR) => continue,
-            Err(e) => return Err(format!("waiting for readiness: {e}")),
-        }
-        let mut buf = [0u8; 16];
-        match nix::unistd::read(pipe, &mut buf) {
-            Ok(0) => return Err("it exited or closed its readiness pipe first".into()),
-            Ok(n) => got.extend_from_slice(&buf[..n]),
-            Err(nix::errno::Errno::EINTR) => continue,
-            Err(e) => return Err(format!("reading readiness: {e}")),
-        }
-        if got.starts_with(harvey_runtime::READY_LINE) {
-            return Ok(());
-        }
-    }
-}
-
-fn pipe_fd(fd: &OwnedFd) -> std::os::fd::BorrowedFd<'_> {
-    use std::os::fd::AsFd;
-    fd.as_fd()
 }
 
 /// SIGTERM to the child's process group, then SIGKILL after `grace`; reaps the child and returns
@@ -137,14 +137,26 @@ pub fn stop(r: &mut Running, grace: Duration) -> ExitStatus {
     // The child leads its own process group: signal the group, so helpers it started go too.
     let group = Pid::from_raw(-(r.child.id() as i32));
     let _ = kill(group, Signal::SIGTERM);
-    let deadline = Instant::now() + grace;
-    while Instant::now() < deadline {
-        if let Ok(Some(status)) = r.child.try_wait() {
-            return status;
-        }
-        std::thread::sleep(Duration::from_millis(10));
+    if let Some(status) = wait_exit(r, grace) {
+        return status;
     }
     tracing::warn!(service = %r.name, "did not stop within {} ms: SIGKILL", grace.as_millis());
     let _ = kill(group, Signal::SIGKILL);
     r.child.wait().unwrap_or_else(|_| ExitStatus::from_raw(libc::SIGKILL))
+}
+
+/// Reaps the child if it exits within `grace`: woken by its pidfd, else checked every 10 ms.
+fn wait_exit(r: &mut Running, grace: Duration) -> Option<ExitStatus> {
+    let deadline = Instant::now() + grace;
+    while Instant::now() < deadline {
+        if let Ok(Some(status)) = r.child.try_wait() {
+            return Some(status);
+        }
+        let left = deadline.saturating_duration_since(Instant::now());
+        let woken = r.exit_fd().map(|fd| poll_input(&[fd], Some(left)));
+        if !matches!(woken, Some(Ok(_))) {
+            std::thread::sleep(EXIT_POLL.min(left));
+        }
+    }
+    None
 }

@@ -3,7 +3,7 @@
 
 use std::time::{Duration, Instant};
 
-use harvey_bus::{Bus, Publisher, Subscriber};
+use harvey_bus::{Bus, BusError, Publisher, Subscriber};
 use harvey_msgs::{Header, Progress, topics};
 
 /// How long the chain may stand still before the supervisor names the party it waits for.
@@ -27,7 +27,7 @@ pub struct ClockWatch {
 
 impl ClockWatch {
     /// `chain` is the parties in turn order, master first.
-    pub fn new(prefix: &str, chain: &[String]) -> anyhow::Result<Self> {
+    pub fn new(prefix: &str, chain: &[String]) -> Result<Self, BusError> {
         let bus = Bus::join_with_prefix("harvey-supervisor", prefix)?;
         let parties = chain
             .iter()
@@ -40,12 +40,12 @@ impl ClockWatch {
                     last: None,
                 })
             })
-            .collect::<anyhow::Result<Vec<_>>>()?;
+            .collect::<Result<Vec<_>, BusError>>()?;
         Ok(Self { parties, moved_at: Instant::now(), warned: false, _bus: bus })
     }
 
     /// Starts the chain: the tail "has finished" tick 0, so the master begins tick 1.
-    pub fn start(&mut self) -> anyhow::Result<()> {
+    pub fn start(&mut self) -> Result<(), BusError> {
         let Some(tail) = self.parties.last_mut() else { return Ok(()) };
         tail.stand_in.send(&Progress { header: Header::new(0, 0) })?;
         tail.last = Some(0);
@@ -55,7 +55,7 @@ impl ClockWatch {
     }
 
     /// Takes in the parties' progress; warns once when the chain has not moved for a while.
-    pub fn poll(&mut self) -> anyhow::Result<()> {
+    pub fn poll(&mut self) -> Result<(), BusError> {
         for p in &mut self.parties {
             if let Some(m) = p.progress.latest()? {
                 p.last = Some(m.header.stamp_ns);
@@ -91,7 +91,7 @@ impl ClockWatch {
 
     /// After `party` restarted: if its predecessor finished a tick it had not, hand the restarted
     /// party that turn again (its earlier self took the notice with it).
-    pub fn resume(&mut self, party: &str) -> anyhow::Result<()> {
+    pub fn resume(&mut self, party: &str) -> Result<(), BusError> {
         self.poll()?;
         let n = self.parties.len();
         let Some(i) = self.parties.iter().position(|p| p.name == party) else { return Ok(()) };
