@@ -3,6 +3,7 @@
 //! of the same mission, measured in the same run. Target: replay ≥ 50x real time.
 //!
 //! `cargo build --release --workspace && cargo bench --bench replay`
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 use std::path::Path;
 use std::process::Command;

@@ -1,6 +1,7 @@
 //! The denning-bridge on a real pseudo-terminal, with this test playing the DRV: valid reports
 //! arrive on the bus intact and in order although random garbage and cut frames are injected
 //! between them; bus commands come out as DRV frames, and impossible ones never reach the line.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

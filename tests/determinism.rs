@@ -2,6 +2,7 @@
 //! same messages (topic, log time, bytes) even when two runs share the machine; another seed does
 //! not; the reference recording replays exactly through the live services; and a clock party
 //! killed mid-run is restarted and the chain resumed, so the mission still ends.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

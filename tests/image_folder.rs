@@ -1,6 +1,7 @@
 //! The camera's folder source across processes: PNG and JPEG images are played in name order as
 //! frames in shared memory, pixel for pixel (PNG) or within JPEG's loss; a folder of mixed sizes
 //! is an error naming the file.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

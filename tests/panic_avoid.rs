@@ -3,6 +3,7 @@
 //! aside, holds it still while the cart goes by, and the executive then gets back to its goal.
 //! With the reflex turned off (the control), the panic-stop freezes the robot in the cart's way
 //! and the cart would hit it.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

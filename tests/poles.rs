@@ -2,6 +2,7 @@
 //! places drawn from the seed; the robot finds, goes to and parks by each under the move-to-pole
 //! acceptor. At least nine must be visited within the 20 simulated minutes (the paper's robot
 //! found eight), judged from the true path, not from what the robot believes.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

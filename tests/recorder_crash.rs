@@ -1,6 +1,7 @@
 //! Crash safety of the recorder: SIGKILLed mid-stream it loses at most about a second (it flushes
 //! every 500 ms), `harvey recover` salvages every complete chunk into a valid file, and a
 //! truncated or corrupt file gets a clear error from the tools, never a panic.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! The supervisor under stress: a service killed with SIGKILL is restarted and data flows again
 //! within a second while the others never stop; bad launch files and failing services get clear
 //! errors, no hang, no orphans and no stale shared memory.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

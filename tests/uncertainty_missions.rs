@@ -1,6 +1,7 @@
 //! 002 Fig. 79 against Fig. 80 as missions: the same 20 ft down the hallway with and without the
 //! vision workers looking for the Expecter's landmarks. Both hold the true pose in every map; the
 //! map with landmarks ends several times smaller, its heading wedge too.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

@@ -1,6 +1,7 @@
 //! The walking skeleton end to end: `harvey run` on the default mission starts every service as a
 //! process, the executive's MOVEs drive the simulated DRV over its pty, data reaches every
 //! consumer, the recorder writes every topic to `run.mcap`, and everything is cleaned up.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 

@@ -8,6 +8,7 @@
 //! bytes over the wall time of all rounds, payload writing included.
 //!
 //! Run: `cargo bench -p harvey-bus --bench transport`.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 use std::io::{BufRead, BufReader, Read, Write};
 use std::os::unix::net::{UnixListener, UnixStream};

@@ -1,5 +1,6 @@
 //! The bus within one process (two nodes): typed delivery with wake-ups, frames in place, and
 //! clear errors for a topic opened with the wrong type and for bad prefixes.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use std::time::Duration;
 

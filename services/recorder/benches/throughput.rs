@@ -4,6 +4,7 @@
 //! (the same bytes written raw to a file and synced).
 //!
 //! Run: `cargo build --release --workspace && cargo bench -p harvey-recorder --bench throughput`.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
