@@ -7,8 +7,8 @@ use std::time::Duration;
 use crate::child::{self, Running, SpawnError};
 use crate::config::{LaunchFile, Service};
 use crate::error::SupervisorError;
+use crate::outcome::Options;
 use crate::policy::RestartPolicy;
-use crate::supervisor::Options;
 
 /// One service of a launch: how to start it, and its process while it runs.
 pub struct Slot {

@@ -9,10 +9,10 @@ use crate::child::describe;
 use crate::clock::ClockWatch;
 use crate::config::LaunchFile;
 use crate::error::{SupervisorError, chain};
+use crate::outcome::Outcome;
 use crate::policy::Decision;
 use crate::signals::Signals;
 use crate::slots::Slot;
-use crate::supervisor::Outcome;
 use crate::wait::poll_input;
 
 /// How often the clock chain's progress is sampled, and how often children are checked where

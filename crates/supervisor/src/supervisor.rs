@@ -2,45 +2,16 @@
 //! restarts them by policy with backoff and a limit; cleans the bus after dead processes; and on
 //! SIGINT/SIGTERM, or when the `end_with` service exits, stops them in reverse order.
 
-use std::path::PathBuf;
 use std::time::Duration;
 
 use crate::child::{self, describe};
 use crate::clock::ClockWatch;
 use crate::config::LaunchFile;
 use crate::error::SupervisorError;
+use crate::outcome::{Options, Outcome};
 use crate::signals::Signals;
 use crate::slots::{self, Slot};
 use crate::supervise::supervise;
-
-/// How a launch ended.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub enum Outcome {
-    /// The `end_with` service exited with this code (0: the mission is done).
-    Ended { service: String, code: i32 },
-    /// SIGINT or SIGTERM.
-    Interrupted,
-    /// A service failed more often than its policy allows.
-    GaveUp { service: String },
-}
-
-impl Outcome {
-    /// The process exit code the CLI returns.
-    pub fn exit_code(&self) -> i32 {
-        match self {
-            Outcome::Ended { code, .. } => *code,
-            Outcome::Interrupted => 130,
-            Outcome::GaveUp { .. } => 1,
-        }
-    }
-}
-
-/// Where and how to run a launch file.
-#[derive(Debug, Clone)]
-pub struct Options {
-    pub prefix: String,
-    pub run_dir: PathBuf,
-}
 
 /// Runs a launch file to its end. Services are stopped whatever happens.
 pub fn run(launch: &LaunchFile, opts: &Options) -> Result<Outcome, SupervisorError> {

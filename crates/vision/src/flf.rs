@@ -50,19 +50,8 @@ impl Default for FlfParams {
     }
 }
 
-/// A fitted line with its region's statistics.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Line {
-    pub from: [f32; 2],
-    pub to: [f32; 2],
-    pub length: f32,
-    /// Direction of the line, 0..180 degrees.
-    pub orientation_deg: f32,
-    pub mean_gradient: f32,
-    /// Standard deviation of the support across the line.
-    pub dispersion: f32,
-    pub pixels: u32,
-}
+/// The fitted line the finder reports (defined with the region moments it comes from).
+pub use crate::regions::Line;
 
 /// The line finder with its buffers and its orientation look-up table.
 #[derive(Debug, Default)]

@@ -2,8 +2,21 @@
 //! the touching runs (8-connected) of the row above with union-find. Region moments come from
 //! closed forms over each run. Shared by the line finder and the region segmenter.
 
-use crate::flf::Line;
 use crate::image::Gray;
+
+/// A fitted line with its region's statistics.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Line {
+    pub from: [f32; 2],
+    pub to: [f32; 2],
+    pub length: f32,
+    /// Direction of the line, 0..180 degrees.
+    pub orientation_deg: f32,
+    pub mean_gradient: f32,
+    /// Standard deviation of the support across the line.
+    pub dispersion: f32,
+    pub pixels: u32,
+}
 
 /// A horizontal run of one class: row `y`, columns `x0 .. x1`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,0 +1,32 @@
+//! What a launch is given (its bus domain and run folder) and how it ended.
+
+use std::path::PathBuf;
+
+/// How a launch ended.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Outcome {
+    /// The `end_with` service exited with this code (0: the mission is done).
+    Ended { service: String, code: i32 },
+    /// SIGINT or SIGTERM.
+    Interrupted,
+    /// A service failed more often than its policy allows.
+    GaveUp { service: String },
+}
+
+impl Outcome {
+    /// The process exit code the CLI returns.
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            Outcome::Ended { code, .. } => *code,
+            Outcome::Interrupted => 130,
+            Outcome::GaveUp { .. } => 1,
+        }
+    }
+}
+
+/// Where and how to run a launch file.
+#[derive(Debug, Clone)]
+pub struct Options {
+    pub prefix: String,
+    pub run_dir: PathBuf,
+}
