@@ -1,10 +1,14 @@
 //! The acceptor-sequenced behaviours a mission may run instead of a script or a plan (004):
-//! docking and the pole hunt, behind one face for the executive.
+//! docking and the pole hunt, behind one face, and run as the executive's mode.
 
-use harvey_msgs::{BehaviourState, MotionCommand, Pose2, SonarRing, VisionRequest, VisionResult};
+use harvey_msgs::{
+    BehaviourState, MissionState, MotionCommand, Odometry, Pose2, ServoLevel, SonarRing, VisionRequest,
+    VisionResult,
+};
 
-use crate::docking::Docking;
-use crate::pole_hunt::PoleHunt;
+use super::docking::Docking;
+use super::pole_hunt::PoleHunt;
+use crate::{Output, Progress};
 
 #[derive(Debug, Clone)]
 pub enum Behaviour {
@@ -67,6 +71,84 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.goal_pose(),
             Self::Poles(p) => p.goal_pose(),
+        }
+    }
+}
+
+/// Where a behaviour run as the mission stands.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Stage {
+    /// No odometry yet.
+    Waiting,
+    Running,
+    Done(MissionState),
+}
+
+/// A behaviour as the executive's mode: started by the first odometry, over when it says so
+/// (or when the mission's time runs out).
+#[derive(Debug, Clone)]
+pub struct Run {
+    pub behaviour: Behaviour,
+    stage: Stage,
+    estimated: Pose2,
+    goal: Pose2,
+}
+
+impl Run {
+    pub fn new(behaviour: Behaviour) -> Self {
+        Self { behaviour, stage: Stage::Waiting, estimated: Pose2::default(), goal: Pose2::default() }
+    }
+
+    pub fn state(&self) -> MissionState {
+        match self.stage {
+            Stage::Done(s) => s,
+            _ => MissionState::Running,
+        }
+    }
+
+    /// Whether the first odometry is still to come.
+    pub fn waiting(&self) -> bool {
+        self.stage == Stage::Waiting
+    }
+
+    /// The mission's time ran out: over, well if the behaviour did enough.
+    pub fn finish(&mut self) {
+        let enough = self.behaviour.enough_at_timeout();
+        self.stage = Stage::Done(if enough { MissionState::Succeeded } else { MissionState::Failed });
+    }
+
+    /// One odometry tick: the behaviour's request, velocity command and state, while it runs.
+    pub fn on_odometry(&mut self, o: &Odometry) -> Vec<Output> {
+        let (at, now) = (o.world_from_robot, o.header.stamp_ns);
+        self.estimated = at;
+        if self.stage == Stage::Waiting {
+            self.stage = Stage::Running;
+        }
+        let mut out = Vec::new();
+        if self.stage == Stage::Running {
+            let b = &mut self.behaviour;
+            let (look, command, state) = b.on_odometry(at, now);
+            (self.estimated, self.goal) = (b.believed(at), b.goal_pose());
+            out.extend(look.map(Output::Look));
+            out.push(Output::Command(command));
+            out.push(Output::Behaviour(state));
+            if let Some(well) = b.done() {
+                self.stage = Stage::Done(if well { MissionState::Succeeded } else { MissionState::Failed });
+            }
+        }
+        out
+    }
+
+    /// What the status reports: a behaviour has no script steps, and servos on nothing the
+    /// status names.
+    pub fn progress(&self) -> Progress {
+        Progress {
+            state: self.state(),
+            step: 0,
+            step_count: 0,
+            servo: ServoLevel::None,
+            estimated: self.estimated,
+            goal: self.goal,
         }
     }
 }

@@ -3,6 +3,8 @@
 
 use harvey_msgs::Pose2;
 
+use harvey_geometry::wrap;
+
 use crate::mission::DockingGoal;
 
 /// The robot's pose from the dock recognised in the image (the inverse perspective of 004
@@ -24,7 +26,7 @@ pub fn pose_from_dock(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64
         return None;
     }
     let turned = sin_turned.asin();
-    let heading = crate::recover::wrap(g.dock_facing_deg.to_radians() + std::f64::consts::PI + turned);
+    let heading = wrap(g.dock_facing_deg.to_radians() + std::f64::consts::PI + turned);
     let bearing = ((centre_u - u) / focal_px).atan();
     let ray = (z_left + z_right) / 2.0 / bearing.cos();
     let a = heading + bearing;

@@ -7,17 +7,19 @@
 //! frame: controlled motion towards it, until it is large (near); q3 ultrasonic positioning:
 //! hold the heading until the sonar says the dock is at the final distance; q4 docked.
 
+use harvey_geometry::wrap;
 use harvey_msgs::{
     BehaviourState, MotionCommand, Pose2, SonarRing, VisionAlgorithm, VisionRequest, VisionResult,
     VisionStatus,
 };
 
-use crate::dock_pose::{face_distance, pose_from_dock};
-use crate::drive::{self, DriveParams, Vectors};
-use crate::fsa::{Fsa, Trigger};
+use super::dock_pose::{face_distance, pose_from_dock};
+use super::drive::{self, DriveParams, Vectors};
+use super::fsa::{Fsa, Trigger};
+use super::schemas::{Noise, V2, move_to_goal};
+use super::sequenced::Sequenced;
 use crate::mission::DockingGoal;
-use crate::schemas::{Noise, V2, move_to_goal};
-use crate::sequenced::Sequenced;
+use crate::servo::belief::Belief;
 
 /// The docking behaviour's state.
 #[derive(Debug, Clone)]
@@ -38,9 +40,8 @@ pub struct Docking {
     hough_at: Option<[f64; 2]>,
     /// Whether it docked, once the acceptor has accepted.
     pub done: Option<bool>,
-    /// Odometry now, and `(odometry then, pose then)` of the last fix from the dock.
-    odometry: Pose2,
-    fix: Option<(Pose2, Pose2)>,
+    /// Odometry now, and the last fix from the dock.
+    belief: Belief,
     /// The believed heading when the target was last seen, and ticks since the last fix asked.
     target_heading: f64,
     since_fix: u32,
@@ -71,8 +72,7 @@ impl Docking {
             target: None,
             hough_at: None,
             done: None,
-            odometry: Pose2::default(),
-            fix: None,
+            belief: Belief::default(),
             target_heading: 0.0,
             since_fix: 0,
         }
@@ -84,7 +84,7 @@ impl Docking {
         Pose2 {
             x_m: self.g.dock_m[0] + self.g.final_m * n.cos(),
             y_m: self.g.dock_m[1] + self.g.final_m * n.sin(),
-            heading_rad: crate::recover::wrap(n + std::f64::consts::PI),
+            heading_rad: wrap(n + std::f64::consts::PI),
         }
     }
 
@@ -101,7 +101,7 @@ impl Docking {
 
     /// Odometry, moved by the last fix from the dock.
     pub fn believed(&self) -> Pose2 {
-        crate::refining::fixed(self.fix, self.odometry)
+        self.belief.believed()
     }
 
     pub fn on_sonar(&mut self, r: &SonarRing) {
@@ -119,10 +119,9 @@ impl Docking {
         let dock = r.algorithm == VisionAlgorithm::Dock as u32;
         // A fix far from the belief is a misreading, once the belief has had a first fix.
         let near = |p: &Pose2| {
-            self.fix.is_none()
+            !self.belief.has_fix()
                 || ((p.x_m - at.x_m).hypot(p.y_m - at.y_m) < self.g.fix_gate_m
-                    && crate::recover::wrap(p.heading_rad - at.heading_rad).abs()
-                        < self.g.fix_gate_deg.to_radians())
+                    && wrap(p.heading_rad - at.heading_rad).abs() < self.g.fix_gate_deg.to_radians())
         };
         if let (true, Some(v)) = (dock, &item)
             && let Some(p) = pose_from_dock(&self.g, self.focal_px, self.centre_px[0], v).filter(near)
@@ -133,7 +132,7 @@ impl Docking {
                 heading_deg = p.heading_rad.to_degrees(),
                 "pose from the dock"
             );
-            self.fix = Some((self.odometry, p));
+            self.belief.fix(p);
         }
         match (self.perception(), item) {
             // A fix asked for while tracking: nothing more to it.
@@ -209,7 +208,7 @@ impl Docking {
         odometry: Pose2,
         now: u64,
     ) -> (Option<VisionRequest>, MotionCommand, BehaviourState) {
-        self.odometry = odometry;
+        self.belief.set_odometry(odometry);
         let at = self.believed();
         let d = face_distance(&self.g, at);
         let mut parts = [V2::default(); 5];
@@ -285,7 +284,7 @@ impl Docking {
         let goal = target.plus(n.scale((along - self.g.lead_m).max(self.g.final_m)));
         // ...but never so far off the target that it would leave the image.
         let to_goal = goal.minus(here);
-        let off = crate::recover::wrap(to_goal.y.atan2(to_goal.x) - bearing);
+        let off = wrap(to_goal.y.atan2(to_goal.x) - bearing);
         let keep = self.g.keep_in_view_deg.to_radians();
         let dir = bearing + off.clamp(-keep, keep);
         let speed = self.g.controlled_mps.min(0.5 * (range - self.g.final_m)).max(0.0);

@@ -3,10 +3,10 @@
 //! DRV's velocity command (speed along the heading, turn rate towards the vector), and the
 //! vectors kept for the published behaviour state.
 
+use harvey_geometry::wrap;
 use harvey_msgs::{CommandKind, Header, MotionCommand, Pose2, SonarRing};
 
-use crate::recover::wrap;
-use crate::schemas::{V2, avoid_obstacle, combine};
+use super::schemas::{V2, avoid_obstacle, combine};
 
 /// How the schemas are weighted and the vector driven.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,6 +5,22 @@
 
 use serde::Deserialize;
 
+/// An acceptor that cannot be used, or a trigger it has no transition for.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum FsaError {
+    #[error("{file}: {message}")]
+    Toml { file: String, message: String },
+    /// `what` (the start, an accepting state or a state's transition) names no state.
+    #[error("{file}: {what} names no state `{name}`")]
+    NoSuchState { file: String, what: String, name: String },
+    #[error("{file}: state `{name}` is defined twice")]
+    Twice { file: String, name: String },
+    #[error("{file}: no accepting state")]
+    NoAccepting { file: String },
+    #[error("{fsa}: state `{state}` has no {trigger:?} transition")]
+    NoTransition { fsa: String, state: String, trigger: Trigger },
+}
+
 /// The kinds of perceptual input that drive a transition.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Trigger {
@@ -59,18 +75,20 @@ pub struct Fsa {
 
 impl Fsa {
     /// Parses and checks an acceptor; errors name the file and what is wrong.
-    pub fn parse(text: &str, file: &str) -> Result<Self, String> {
-        let spec: Spec = toml::from_str(text).map_err(|e| format!("{file}: {e}"))?;
+    pub fn parse(text: &str, file: &str) -> Result<Self, FsaError> {
+        let spec: Spec = toml::from_str(text)
+            .map_err(|e| FsaError::Toml { file: file.to_owned(), message: e.to_string() })?;
         let index = |name: &str, what: &str| {
-            spec.states
-                .iter()
-                .position(|s| s.name == name)
-                .ok_or_else(|| format!("{file}: {what} names no state `{name}`"))
+            spec.states.iter().position(|s| s.name == name).ok_or_else(|| FsaError::NoSuchState {
+                file: file.to_owned(),
+                what: what.to_owned(),
+                name: name.to_owned(),
+            })
         };
         if let Some(s) =
             spec.states.iter().find(|s| spec.states.iter().filter(|o| o.name == s.name).count() > 1)
         {
-            return Err(format!("{file}: state `{}` is defined twice", s.name));
+            return Err(FsaError::Twice { file: file.to_owned(), name: s.name.clone() });
         }
         let mut states = Vec::new();
         for s in &spec.states {
@@ -87,7 +105,7 @@ impl Fsa {
         let start = index(&spec.start, "start")?;
         let accept = spec.accept.iter().map(|a| index(a, "accept")).collect::<Result<Vec<_>, _>>()?;
         if accept.is_empty() {
-            return Err(format!("{file}: no accepting state"));
+            return Err(FsaError::NoAccepting { file: file.to_owned() });
         }
         Ok(Self { name: spec.name, states, start, accept, current: start, trace: vec![start] })
     }
@@ -104,15 +122,18 @@ impl Fsa {
 
     /// Takes one trigger; returns the state entered. A trigger the state has no transition for
     /// is an error, and the acceptor stays where it was.
-    pub fn step(&mut self, t: Trigger) -> Result<&State, String> {
+    pub fn step(&mut self, t: Trigger) -> Result<&State, FsaError> {
         let k = match t {
             Trigger::Normal => 0,
             Trigger::Terminal => 1,
             Trigger::Recoverable => 2,
             Trigger::Fatal => 3,
         };
-        let to = self.states[self.current].next[k]
-            .ok_or_else(|| format!("{}: state `{}` has no {t:?} transition", self.name, self.state().name))?;
+        let to = self.states[self.current].next[k].ok_or_else(|| FsaError::NoTransition {
+            fsa: self.name.clone(),
+            state: self.state().name.clone(),
+            trigger: t,
+        })?;
         if to != self.current {
             self.trace.push(to);
         }
@@ -186,7 +207,7 @@ mod tests {
         assert_eq!(f.trace_names(), ["q0", "q1", "q2", "q0", "q1", "q2", "q3", "q4"]);
         assert!(f.accepted());
         f.reset();
-        let e = f.step(Fatal).expect_err("no fatal transition");
+        let e = f.step(Fatal).expect_err("no fatal transition").to_string();
         assert!(e.contains("state `q0` has no Fatal transition"), "{e}");
         assert_eq!(f.state().name, "q0");
     }
@@ -200,11 +221,11 @@ mod tests {
         .expect("readable");
         let e =
             Fsa::parse(&good.replace("terminal = \"q1\"", "terminal = \"q9\""), "d.toml").expect_err("bad");
-        assert_eq!(e, "d.toml: state `q0` terminal names no state `q9`");
+        assert_eq!(e.to_string(), "d.toml: state `q0` terminal names no state `q9`");
         let e = Fsa::parse(&good.replace("start = \"q0\"", "start = \"qq\""), "d.toml").expect_err("bad");
-        assert_eq!(e, "d.toml: start names no state `qq`");
+        assert_eq!(e.to_string(), "d.toml: start names no state `qq`");
         let e = Fsa::parse(&good.replace("name = \"q5\"", "name = \"q4\""), "d.toml").expect_err("dup");
-        assert_eq!(e, "d.toml: state `q4` is defined twice");
-        assert!(Fsa::parse("name = 3", "x.toml").expect_err("malformed").starts_with("x.toml:"));
+        assert_eq!(e.to_string(), "d.toml: state `q4` is defined twice");
+        assert!(Fsa::parse("name = 3", "x.toml").expect_err("malformed").to_string().starts_with("x.toml:"));
     }
 }

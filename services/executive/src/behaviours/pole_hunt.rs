@@ -8,16 +8,16 @@
 //! (recoverable: re-acquire the pole); q3 parking by the sonar's nearest echo towards the pole;
 //! q4 parked, and the assemblage starts on the next pole.
 
+use harvey_geometry::wrap;
 use harvey_msgs::{
     BehaviourState, MotionCommand, Pose2, SonarRing, VisionAlgorithm, VisionRequest, VisionResult,
 };
 
-use crate::drive::{self, DriveParams};
-use crate::fsa::{Fsa, Trigger};
+use super::drive::{self, DriveParams};
+use super::fsa::{Fsa, Trigger};
+use super::schemas::{AvoidPast, Noise, V2, move_to_goal, probe};
+use super::sequenced::Sequenced;
 use crate::mission::PolesGoal;
-use crate::recover::wrap;
-use crate::schemas::{AvoidPast, Noise, V2, move_to_goal, probe};
-use crate::sequenced::Sequenced;
 
 /// What q0 is doing.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -4,6 +4,8 @@
 //! noise (seeded) wanders to escape local minima, avoid-past repels from places recently
 //! visited, and probe pulls towards open space.
 
+use harvey_geometry::Rng;
+
 /// A planar vector (m/s, or unit-free for directions), world frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct V2 {
@@ -68,7 +70,7 @@ pub fn avoid_obstacle(
 /// generator (same seed, same wandering).
 #[derive(Debug, Clone)]
 pub struct Noise {
-    state: u64,
+    rng: Rng,
     held: V2,
     left: u32,
     pub gain: f64,
@@ -78,7 +80,7 @@ pub struct Noise {
 impl Noise {
     pub fn new(seed: u64, gain: f64, persistence: u32) -> Self {
         Self {
-            state: seed ^ 0x9e37_79b9_7f4a_7c15,
+            rng: Rng::new(seed ^ 0x9e37_79b9_7f4a_7c15),
             held: V2::default(),
             left: 0,
             gain,
@@ -88,12 +90,7 @@ impl Noise {
 
     pub fn vector(&mut self) -> V2 {
         if self.left == 0 {
-            // splitmix64
-            self.state = self.state.wrapping_add(0x9e37_79b9_7f4a_7c15);
-            let mut z = self.state;
-            z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-            let a = (z ^ (z >> 31)) as f64 / u64::MAX as f64 * std::f64::consts::TAU;
+            let a = self.rng.unit() * std::f64::consts::TAU;
             (self.held, self.left) = (V2::new(a.cos(), a.sin()).scale(self.gain), self.persistence);
         }
         self.left -= 1;

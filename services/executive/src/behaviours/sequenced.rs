@@ -6,8 +6,8 @@ use harvey_msgs::{
     BehaviourState, Header, MotionCommand, Pose2, VisionAlgorithm, VisionRequest, VisionResult,
 };
 
-use crate::drive::{self, Vectors};
-use crate::fsa::{Fsa, Trigger};
+use super::drive::{self, Vectors};
+use super::fsa::{Fsa, Trigger};
 
 /// The acceptor and the request and command bookkeeping.
 #[derive(Debug, Clone)]

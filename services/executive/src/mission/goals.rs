@@ -4,7 +4,7 @@
 
 use serde::Deserialize;
 
-use crate::mission::greater;
+use super::greater;
 
 /// A goal for plan-and-monitor (`[mission.ptrans]`, 000 §2, §4): get to a place in locale `to`
 /// from wherever the robot starts, checking a milestone after each subgoal.
@@ -137,22 +137,22 @@ pub struct PolesGoal {
     pub noise_ticks: u32,
 }
 
-pub(crate) fn check_ptrans(p: &PtransGoal) -> Result<(), String> {
+pub(crate) fn check_ptrans(p: &PtransGoal) -> Result<(), &'static str> {
     let lengths =
         [p.approach_m, p.door_depth_m, p.milestone_m, p.goal_tolerance_m, p.escalate_m, p.back_off_m];
     if !lengths.iter().all(|&v| greater(v, 0.0)) || !p.goal_heading_deg.is_finite() {
-        return Err("lengths must be positive and the heading finite".into());
+        return Err("lengths must be positive and the heading finite");
     }
     if !p.goal_m.iter().all(|v| v.is_finite()) || p.attempts == 0 {
-        return Err("goal_m must be finite and attempts at least 1".into());
+        return Err("goal_m must be finite and attempts at least 1");
     }
     if p.escalate_m <= p.milestone_m.max(p.goal_tolerance_m) {
-        return Err("escalate_m must exceed milestone_m and goal_tolerance_m".into());
+        return Err("escalate_m must exceed milestone_m and goal_tolerance_m");
     }
     Ok(())
 }
 
-pub(crate) fn check_docking(d: &DockingGoal) -> Result<(), String> {
+pub(crate) fn check_docking(d: &DockingGoal) -> Result<(), &'static str> {
     let positive = [
         d.frame_width_m,
         d.target_side_m,
@@ -168,22 +168,22 @@ pub(crate) fn check_docking(d: &DockingGoal) -> Result<(), String> {
         d.avoid_sphere_m,
     ];
     if !positive.iter().all(|&v| greater(v, 0.0)) {
-        return Err("sizes, ranges, speeds and gains must be positive".into());
+        return Err("sizes, ranges, speeds and gains must be positive");
     }
     let finite = [d.dock_m[0], d.dock_m[1], d.dock_facing_deg, d.frame_height_m, d.target_height_m];
     if !(finite.iter().all(|v| v.is_finite()) && d.hough_range_sd_m >= 0.0 && d.noise_mps >= 0.0) {
-        return Err("the dock's place and the spreads must be finite".into());
+        return Err("the dock's place and the spreads must be finite");
     }
     if !(0.0..=1.0).contains(&d.hough_min_certainty) || !greater(d.final_m, d.too_close_m) {
-        return Err("hough_min_certainty must be in 0..1 and too_close_m under final_m".into());
+        return Err("hough_min_certainty must be in 0..1 and too_close_m under final_m");
     }
     if !(0.0 <= d.target_grey[0] && d.target_grey[0] <= d.target_grey[1] && d.target_grey[1] <= 255.0) {
-        return Err("target_grey must be two grey levels, low then high".into());
+        return Err("target_grey must be two grey levels, low then high");
     }
     Ok(())
 }
 
-pub(crate) fn check_poles(p: &PolesGoal) -> Result<(), String> {
+pub(crate) fn check_poles(p: &PolesGoal) -> Result<(), &'static str> {
     let positive = [
         p.sweep_deg,
         p.centred_deg,
@@ -199,10 +199,10 @@ pub(crate) fn check_poles(p: &PolesGoal) -> Result<(), String> {
         p.past_cell_m,
     ];
     if !positive.iter().all(|&v| greater(v, 0.0)) || !(0.0..=1.0).contains(&p.past_decay) {
-        return Err("angles, times, distances, speeds and gains must be positive, past_decay in 0..1".into());
+        return Err("angles, times, distances, speeds and gains must be positive, past_decay in 0..1");
     }
     if p.count == 0 || p.enough > p.count || !greater(p.lost_m, p.park_m) || !greater(p.near_m, p.park_m) {
-        return Err("count at least 1, enough at most count, lost_m and near_m beyond park_m".into());
+        return Err("count at least 1, enough at most count, lost_m and near_m beyond park_m");
     }
     Ok(())
 }

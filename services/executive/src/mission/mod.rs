@@ -4,8 +4,12 @@
 
 use serde::Deserialize;
 
-pub use crate::goals::{DockingGoal, PolesGoal, PtransGoal};
-use crate::goals::{check_docking, check_poles, check_ptrans};
+mod error;
+pub mod goals;
+
+pub use error::MissionError;
+pub use goals::{DockingGoal, PolesGoal, PtransGoal};
+use goals::{check_docking, check_poles, check_ptrans};
 
 /// One primitive: exactly one of `move_m` and `turn_deg` is set. A move may be driven in
 /// increments, and servoed on a landmark after each (000 §5.5).
@@ -63,7 +67,7 @@ pub struct Servo {
     /// `increment` (000 §5.5 as written) or `whole` (the default: the offset summed over the
     /// leg's increments).
     #[serde(default)]
-    pub offset: crate::leg::Tracking,
+    pub offset: crate::script::leg::Tracking,
 }
 
 /// The `[mission]` table of a launch file.
@@ -88,66 +92,56 @@ struct File {
 }
 
 /// Reads the `[mission]` table of a launch file; other tables belong to the supervisor.
-pub fn parse(text: &str, file: &str) -> Result<Mission, String> {
-    let doc: toml::Table = toml::from_str(text).map_err(|e| format!("{file}: {}", e.message()))?;
+pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
+    let file_name = || file.to_owned();
+    let doc: toml::Table = toml::from_str(text)
+        .map_err(|e| MissionError::Toml { file: file_name(), message: e.message().to_owned() })?;
     let only_mission: toml::Table = doc.into_iter().filter(|(k, _)| k == "mission").collect();
-    let parsed: File = serde_path_to_error::deserialize(only_mission)
-        .map_err(|e| format!("{file}: field `{}`: {}", e.path(), e.inner().message()))?;
-    let m = parsed.mission.ok_or_else(|| format!("{file}: no [mission] table"))?;
+    let parsed: File = serde_path_to_error::deserialize(only_mission).map_err(|e| MissionError::Field {
+        file: file_name(),
+        path: e.path().to_string(),
+        message: e.inner().message().to_owned(),
+    })?;
+    let m = parsed.mission.ok_or_else(|| MissionError::NoMission { file: file_name() })?;
     if !greater(m.timeout_s, 0.0) {
-        return Err(format!("{file}: mission.timeout_s must be positive"));
+        return Err(MissionError::Timeout { file: file_name() });
     }
     let behaviours =
         usize::from(m.ptrans.is_some()) + usize::from(m.docking.is_some()) + usize::from(m.poles.is_some());
     match (behaviours, m.steps.is_empty()) {
-        (0, true) => {
-            return Err(format!(
-                "{file}: the mission has no [[mission.step]], [mission.ptrans], [mission.docking] or [mission.poles]"
-            ));
-        }
+        (0, true) => return Err(MissionError::NothingToDo { file: file_name() }),
         (1, true) | (0, false) => {}
-        _ => {
-            return Err(format!(
-                "{file}: [mission.ptrans], [mission.docking] and [mission.poles] make their own steps: one of \
-                 them, and no [[mission.step]]"
-            ));
-        }
+        _ => return Err(MissionError::TooMuchToDo { file: file_name() }),
     }
+    let goal = |table, what| MissionError::Goal { file: file_name(), table, what };
     if let Some(p) = &m.poles {
-        check_poles(p).map_err(|e| format!("{file}: mission.poles: {e}"))?;
+        check_poles(p).map_err(|what| goal("poles", what))?;
     }
     if let Some(p) = &m.ptrans {
-        check_ptrans(p).map_err(|e| format!("{file}: mission.ptrans: {e}"))?;
+        check_ptrans(p).map_err(|what| goal("ptrans", what))?;
     }
     if let Some(d) = &m.docking {
-        check_docking(d).map_err(|e| format!("{file}: mission.docking: {e}"))?;
+        check_docking(d).map_err(|what| goal("docking", what))?;
     }
-    for (i, s) in m.steps.iter().enumerate() {
+    for (index, s) in m.steps.iter().enumerate() {
         match (s.move_m, s.turn_deg, s.refine_pose) {
             (Some(v), None, false) | (None, Some(v), false) if v.is_finite() => {}
             (None, None, true) if m.refine.as_ref().is_some_and(|r| r.vertices_m.len() >= 2) => {}
-            _ => {
-                return Err(format!(
-                    "{file}: mission.step[{i}] needs exactly one finite `move_m` or `turn_deg`, or \
-                     `refine_pose` with two or more [mission.refine] vertices_m"
-                ));
-            }
+            _ => return Err(MissionError::Step { file: file_name(), index }),
         }
         if let Some(inc) = s.increment_m
             && (s.move_m.is_none() || !greater(inc, 0.0))
         {
-            return Err(format!("{file}: mission.step[{i}].increment_m must be positive, on a move"));
+            return Err(MissionError::Increment { file: file_name(), index });
         }
         if s.servo_landmark.is_some() && (s.increment_m.is_none() || m.servo.is_none()) {
-            return Err(format!(
-                "{file}: mission.step[{i}].servo_landmark needs `increment_m` and a [mission.servo] table"
-            ));
+            return Err(MissionError::ServoLandmark { file: file_name(), index });
         }
     }
     if let Some(sv) = m.servo
         && (!greater(sv.aim_m, 0.0) || !sv.misalignment_deg.is_finite() || sv.template_px < 4)
     {
-        return Err(format!("{file}: mission.servo: aim_m must be positive, template_px at least 4"));
+        return Err(MissionError::Servo { file: file_name() });
     }
     Ok(m)
 }
@@ -173,12 +167,14 @@ mod tests {
             ]
         );
         let both = text.replace("turn_deg = 90", "turn_deg = 90\nmove_m = 1");
-        assert!(parse(&both, "m.toml").expect_err("two fields").contains("mission.step[1]"));
+        assert!(parse(&both, "m.toml").expect_err("two fields").to_string().contains("mission.step[1]"));
         let typo = text.replace("timeout_s", "timeout");
-        assert!(parse(&typo, "m.toml").expect_err("unknown field").contains("m.toml: field `mission"));
+        assert!(
+            parse(&typo, "m.toml").expect_err("unknown field").to_string().contains("m.toml: field `mission")
+        );
         let servoed =
             text.replace("move_m = 2.0", "move_m = 2.0\nincrement_m = 0.5\nservo_landmark = \"sign\"");
-        let e = parse(&servoed, "m.toml").expect_err("no servo table");
+        let e = parse(&servoed, "m.toml").expect_err("no servo table").to_string();
         assert!(e.contains("step[0].servo_landmark needs"), "{e}");
         let table = format!("{servoed}[mission.servo]\naim_m = 1.2\ntemplate_px = 16\nmin_score = 0.9\n");
         let m = parse(&table, "m.toml").expect("parses");
@@ -186,10 +182,12 @@ mod tests {
         let ptrans = "[mission]\ndescription = \"d\"\ntimeout_s = 60\n[mission.ptrans]\nto = \"office\"\ngoal_m = [1.0, 2.0]\ngoal_heading_deg = 90\napproach_m = 0.4\ndoor_depth_m = 0.6\nmilestone_m = 0.15\ngoal_tolerance_m = 0.01\nescalate_m = 0.5\nattempts = 3\nback_off_m = 0.3\n";
         assert_eq!(parse(ptrans, "p.toml").expect("parses").ptrans.map(|p| p.goal_m), Some([1.0, 2.0]));
         let both = format!("{ptrans}[[mission.step]]\nmove_m = 1.0\n");
-        assert!(parse(&both, "p.toml").expect_err("steps too").contains("no [[mission.step]]"));
+        assert!(parse(&both, "p.toml").expect_err("steps too").to_string().contains("no [[mission.step]]"));
         let tight = ptrans.replace("escalate_m = 0.5", "escalate_m = 0.1");
-        assert!(parse(&tight, "p.toml").expect_err("escalate").contains("mission.ptrans: escalate_m"));
+        assert!(
+            parse(&tight, "p.toml").expect_err("escalate").to_string().contains("mission.ptrans: escalate_m")
+        );
         let on_turn = text.replace("turn_deg = 90", "turn_deg = 90\nincrement_m = 0.5");
-        assert!(parse(&on_turn, "m.toml").expect_err("turn").contains("step[1].increment_m"));
+        assert!(parse(&on_turn, "m.toml").expect_err("turn").to_string().contains("step[1].increment_m"));
     }
 }

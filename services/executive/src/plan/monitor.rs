@@ -1,16 +1,16 @@
 //! Plan-and-monitor (000 §2, §4): develops a `(ptrans here goal)` into a plan sketch over the
-//! locale graph (`plan.rs`) and executes its primitive subgoals one by one: TURN to face the
+//! locale graph (`sketch.rs`) and executes its primitive subgoals one by one: TURN to face the
 //! milestone, fix the pose from landmarks (plan-level servoing, 000 §5.6: the subgoal starts from
 //! where the robot is, not where it should be), MOVE, fix again and check the milestone. A check
 //! returns success, or failure with the last known location: a small miss is retried from there
 //! (plan level), a large one or a repeated one re-develops the plan from there (goal level).
 
+use harvey_geometry::wrap;
 use harvey_msgs::{CheckOutcome, Header, PlanSketch, PlanStage, Pose2, SKETCH_PLACES};
 use harvey_world::World;
 
+use super::sketch::{Place, PlanError, Ptrans, refine_leading};
 use crate::mission::{PtransGoal, Step};
-use crate::plan::{Place, PlanError, Ptrans, refine_leading};
-use crate::recover::wrap;
 
 /// Turns and moves smaller than these are not worth commanding (the DRV's units are 0.1° and
 /// 0.01 ft).

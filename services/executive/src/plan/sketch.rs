@@ -144,7 +144,7 @@ mod tests {
     use super::*;
 
     fn hallway() -> World {
-        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("world")
+        harvey_world::load_str(include_str!("../../../../worlds/hallway.toml"), "hallway").expect("world")
     }
 
     fn place(name: &str, at: [f64; 2], locale: &str) -> Place {

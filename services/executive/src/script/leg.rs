@@ -107,8 +107,7 @@ impl Leg {
     /// Where the robot should be after `k` increments: on the line, heading along it.
     pub fn expected(&self, k: usize) -> Pose2 {
         let d = (k as f64 * self.increment_m).min(self.length_m) - self.shortfall_m;
-        let (c, s) = (self.line.heading_rad.cos(), self.line.heading_rad.sin());
-        Pose2 { x_m: self.line.x_m + d * c, y_m: self.line.y_m + d * s, heading_rad: self.line.heading_rad }
+        self.line.arc(d, 0.0)
     }
 
     /// Increments commanded so far.

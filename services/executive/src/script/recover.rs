@@ -3,9 +3,8 @@
 //! then satisfy the previously specified navigational goals"): from where dead reckoning says
 //! the robot now is, face the interrupted step's goal, drive to it and take its heading.
 
-use harvey_msgs::{CommandKind, Pose2};
-
-use harvey_msgs::REFLEX_ID_BIT;
+use harvey_geometry::wrap;
+use harvey_msgs::{CommandKind, Pose2, REFLEX_ID_BIT};
 
 /// Whether the vehicle's current command is a reflex's.
 pub fn is_reflex(command_id: u32) -> bool {
@@ -14,12 +13,6 @@ pub fn is_reflex(command_id: u32) -> bool {
 
 /// Quiet time (ns) after a reflex's last motion before the executive takes over again.
 pub const QUIET_NS: u64 = 2_000_000_000;
-
-/// `a` in `(-π, π]`.
-pub fn wrap(a: f64) -> f64 {
-    let t = a.rem_euclid(std::f64::consts::TAU);
-    if t > std::f64::consts::PI { t - std::f64::consts::TAU } else { t }
-}
 
 /// The primitives from `at` to `goal`: TURN to face it, MOVE there, TURN to its heading (each
 /// left out when negligible), in order.

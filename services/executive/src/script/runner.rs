@@ -1,18 +1,17 @@
-//! The executive's script runner: each TURN/MOVE primitive commanded and checked against
-//! odometry, incremental legs with their looks (000 §5.5), getting back to an interrupted step
-//! after a reflex, plan-and-monitor's steps appended as they are needed, and the behaviours'
-//! commands passed through.
+//! The script runner's steps: each TURN/MOVE primitive commanded and checked against odometry,
+//! incremental legs with their looks (000 §5.5), getting back to an interrupted step after a
+//! reflex, and the [`Sequel`]'s steps appended once the script's own are done.
 
 use harvey_msgs::{
-    CommandKind, Header, MissionState, MotionCommand, Odometry, Pose2, ServoCorrection, VisionRequest,
-    VisionResult, VisionStatus,
+    CommandKind, Header, MotionCommand, Odometry, Pose2, ServoCorrection, VisionRequest, VisionResult,
+    VisionStatus,
 };
 
-use crate::leg::{Leg, LegStep};
-use crate::mission::Step;
-use crate::{Executive, Output, Phase, goal_of, monitor, recover, refining};
+use super::leg::{Leg, LegStep};
+use super::{More, Phase, Script, Sequel, recover};
+use crate::Output;
 
-impl Executive {
+impl Script {
     fn send(&mut self, step: usize, kind: CommandKind, distance_m: f64, angle_rad: f64, now: u64) -> Output {
         let id = self.next_id;
         self.next_id += 1;
@@ -28,11 +27,11 @@ impl Executive {
     }
 
     /// Starts step `step` from the pose `at`.
-    fn begin(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
-        self.step_goal = goal_of(at, std::slice::from_ref(&self.mission.steps[step]));
-        let s: &Step = &self.mission.steps[step];
+    pub(super) fn begin(&mut self, step: usize, at: Pose2, now: u64, sequel: &mut dyn Sequel) -> Vec<Output> {
+        self.step_goal = super::goal_of(at, std::slice::from_ref(&self.steps[step]));
+        let s = &self.steps[step];
         if s.refine_pose {
-            return self.begin_refine(step, now);
+            return self.begin_refine(step, now, sequel);
         }
         match (s.move_m, s.turn_deg, s.increment_m) {
             (Some(d), _, Some(inc)) => {
@@ -40,7 +39,7 @@ impl Executive {
                 let mut leg = Leg::new(at, d, inc, servo);
                 let first = leg.start();
                 self.leg = Some(leg);
-                self.apply(step, first, at, now)
+                self.apply(step, first, at, now, sequel)
             }
             (Some(d), _, None) => vec![self.send(step, CommandKind::Move, d, 0.0, now)],
             (_, a, _) => vec![self.send(step, CommandKind::Turn, 0.0, a.unwrap_or(0.0).to_radians(), now)],
@@ -48,7 +47,14 @@ impl Executive {
     }
 
     /// Carries out what the leg of step `step` wants next.
-    fn apply(&mut self, step: usize, next: LegStep, at: Pose2, now: u64) -> Vec<Output> {
+    fn apply(
+        &mut self,
+        step: usize,
+        next: LegStep,
+        at: Pose2,
+        now: u64,
+        sequel: &mut dyn Sequel,
+    ) -> Vec<Output> {
         match next {
             LegStep::Move(d) => vec![self.send(step, CommandKind::Move, d, 0.0, now)],
             LegStep::Turn(a) => {
@@ -57,7 +63,7 @@ impl Executive {
                     tracing::info!(
                         heading_error_deg = h.to_degrees(),
                         turn_deg = a.to_degrees(),
-                        offset_in = l.offset_m / 0.0254,
+                        offset_in = l.offset_m / harvey_geometry::INCH,
                         shortfall_m = l.shortfall_m,
                         "servo correction"
                     );
@@ -65,8 +71,7 @@ impl Executive {
                 vec![self.send(step, CommandKind::Turn, 0.0, a, now)]
             }
             LegStep::Look(expected) => {
-                let (Some(s), Some(sv)) = (self.leg.as_ref().and_then(|l| l.servo), self.mission.servo)
-                else {
+                let (Some(s), Some(sv)) = (self.leg.as_ref().and_then(|l| l.servo), self.servo_table) else {
                     return Vec::new();
                 };
                 let request = self.next_request;
@@ -86,61 +91,54 @@ impl Executive {
                 if let Some(l) = self.leg.take() {
                     self.legs.push(l);
                 }
-                self.step_done(step, at, now)
+                self.step_done(step, at, now, sequel)
             }
         }
     }
 
-    /// Step `step` is over: the next one, what the plan wants next, or success.
-    pub(crate) fn step_done(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
-        if step + 1 < self.mission.steps.len() {
-            self.begin(step + 1, at, now)
-        } else if self.plan.is_some() {
-            self.plan_next(at, now)
+    /// Step `step` is over: the next one, or what the sequel has next.
+    pub(super) fn step_done(
+        &mut self,
+        step: usize,
+        at: Pose2,
+        now: u64,
+        sequel: &mut dyn Sequel,
+    ) -> Vec<Output> {
+        if step + 1 < self.steps.len() {
+            self.begin(step + 1, at, now, sequel)
         } else {
-            self.phase = Phase::Done(MissionState::Succeeded);
-            Vec::new()
+            self.more(at, now, sequel)
         }
     }
 
-    /// Plan-and-monitor's next steps, appended to the script and begun.
-    fn plan_next(&mut self, at: Pose2, now: u64) -> Vec<Output> {
-        let Some(plan) = self.plan.as_mut() else { return Vec::new() };
-        let next = plan.next(at, self.fixes);
-        self.plan_seq += 1;
-        let mut out = vec![Output::Plan(plan.sketch_msg(self.plan_seq, now))];
-        match next {
-            Ok(monitor::Next::Steps(steps)) => {
-                let first = self.mission.steps.len();
-                self.mission.steps.extend(steps);
-                out.extend(self.begin(first, at, now));
+    /// The sequel's next steps, appended to the script and begun, or the mission's end.
+    fn more(&mut self, at: Pose2, now: u64, sequel: &mut dyn Sequel) -> Vec<Output> {
+        let mut out = Vec::new();
+        match sequel.more(at, self.fixes, now, &mut out) {
+            More::Steps(steps) => {
+                let first = self.steps.len();
+                self.steps.extend(steps);
+                out.extend(self.begin(first, at, now, sequel));
             }
-            Ok(monitor::Next::Arrived) => self.phase = Phase::Done(MissionState::Succeeded),
-            Err(e) => {
-                tracing::error!(error = %e, "plan-and-monitor failed");
-                self.phase = Phase::Done(MissionState::Failed);
-            }
+            More::End(state) => self.phase = Phase::Done(state),
         }
         out
     }
 
     /// The next primitive of the way back to the interrupted step's goal, or the next step.
-    fn resume(&mut self, step: usize, at: Pose2, now: u64) -> Vec<Output> {
+    fn resume(&mut self, step: usize, at: Pose2, now: u64, sequel: &mut dyn Sequel) -> Vec<Output> {
         match self.recovery.pop() {
             Some((kind, v)) if kind == CommandKind::Move => vec![self.send(step, kind, v, 0.0, now)],
             Some((kind, v)) => vec![self.send(step, kind, 0.0, v, now)],
-            None => self.step_done(step, at, now),
+            None => self.step_done(step, at, now, sequel),
         }
     }
 
-    /// A vision result: the answer to the leg's look, if it is the one awaited.
-    pub fn on_vision(&mut self, r: &VisionResult) -> Vec<Output> {
-        if let Some(b) = self.behaviour.as_mut() {
-            b.on_vision(r);
-            return Vec::new();
-        }
+    /// A vision result: the answer to the leg's look, if it is the one awaited, or to the
+    /// refinement under way.
+    pub fn on_vision(&mut self, r: &VisionResult, sequel: &mut dyn Sequel) -> Vec<Output> {
         if matches!(self.phase, Phase::Refining { .. }) {
-            return self.on_refine_result(r);
+            return self.on_refine_result(r, sequel);
         }
         let Phase::Looking { step, request } = self.phase else { return Vec::new() };
         if r.request_id != request {
@@ -166,105 +164,71 @@ impl Executive {
                 shortfall_m: leg.shortfall_m,
             }));
         }
-        out.extend(self.apply(step, next, at, now));
+        out.extend(self.apply(step, next, at, now, sequel));
         out
     }
 
-    /// One odometry message: advance the script; returns commands and the status to publish.
-    pub fn on_odometry(&mut self, o: &Odometry) -> Vec<Output> {
+    /// One odometry message: advances the script; returns the commands and requests to send.
+    pub fn on_odometry(&mut self, o: &Odometry, sequel: &mut dyn Sequel) -> Vec<Output> {
         let now = o.header.stamp_ns;
-        self.odometry = o.world_from_robot;
-        self.estimated = self.believed();
+        self.belief.set_odometry(o.world_from_robot);
+        self.estimated = self.belief.believed();
         let at = self.estimated;
-        let mut out = Vec::new();
-        if let Some(b) = self.behaviour.as_mut() {
-            if matches!(self.phase, Phase::Waiting) {
-                self.start_ns = now;
-                self.phase = Phase::Executing { step: 0, id: 0 };
-            }
-            if !matches!(self.phase, Phase::Done(_)) {
-                let (look, command, state) = b.on_odometry(at, now);
-                (self.estimated, self.goal) = (b.believed(at), b.goal_pose());
-                out.extend(look.map(Output::Look));
-                out.push(Output::Command(command));
-                out.push(Output::Behaviour(state));
-                if let Some(well) = b.done() {
-                    self.phase =
-                        Phase::Done(if well { MissionState::Succeeded } else { MissionState::Failed });
-                }
-            }
-        }
+        let reflex = o.command.command_id;
+        let fresh_reflex = recover::is_reflex(reflex) && reflex != self.handled_reflex;
         match self.phase {
-            _ if self.behaviour.is_some() => {}
             Phase::Waiting => {
-                self.start_ns = now;
-                match &self.plan {
-                    Some(plan) => {
-                        self.goal = plan.goal_pose();
-                        out = self.plan_next(at, now);
-                    }
-                    None => {
-                        self.goal = goal_of(at, &self.mission.steps);
-                        out = self.begin(0, at, now);
-                    }
+                self.goal = sequel.goal(at, &self.steps);
+                if self.steps.is_empty() {
+                    self.more(at, now, sequel)
+                } else {
+                    self.begin(0, at, now, sequel)
                 }
             }
-            Phase::Executing { step, .. } | Phase::Looking { step, .. }
-                if recover::is_reflex(o.command.command_id)
-                    && o.command.command_id != self.handled_reflex =>
-            {
+            Phase::Executing { step, .. } | Phase::Looking { step, .. } if fresh_reflex => {
                 tracing::warn!(step, "a reflex took the vehicle; the step resumes once it is over");
                 self.preemptions += 1;
-                self.handled_reflex = o.command.command_id;
+                self.handled_reflex = reflex;
                 self.leg = None;
                 self.recovery.clear();
                 self.phase = Phase::Preempted { step, since_ns: now };
+                Vec::new()
             }
             Phase::Preempted { step, since_ns } => {
-                let fresh =
-                    recover::is_reflex(o.command.command_id) && o.command.command_id != self.handled_reflex;
-                if fresh {
-                    self.handled_reflex = o.command.command_id;
+                if fresh_reflex {
+                    self.handled_reflex = reflex;
                 }
-                if fresh || o.moving != 0 || o.command_accepted == 0 {
+                if fresh_reflex || o.moving != 0 || o.command_accepted == 0 {
                     self.phase = Phase::Preempted { step, since_ns: now };
+                    Vec::new()
                 } else if now.saturating_sub(since_ns) >= recover::QUIET_NS {
                     self.recovery = recover::back_to(at, self.step_goal);
                     self.recovery.reverse();
-                    out = self.resume(step, at, now);
+                    self.resume(step, at, now, sequel)
+                } else {
+                    Vec::new()
                 }
             }
             Phase::Executing { step, id } => {
                 let finished = o.command.command_id == id && o.command_accepted == 1 && o.moving == 0;
                 if finished && !self.recovery.is_empty() {
-                    out = self.resume(step, at, now);
+                    self.resume(step, at, now, sequel)
                 } else if finished {
-                    out = match self.leg.as_mut() {
+                    match self.leg.as_mut() {
                         Some(leg) => {
                             let next = leg.on_done();
-                            self.apply(step, next, at, now)
+                            self.apply(step, next, at, now, sequel)
                         }
-                        None => self.step_done(step, at, now),
-                    };
+                        None => self.step_done(step, at, now, sequel),
+                    }
+                } else {
+                    Vec::new()
                 }
             }
-            Phase::Refining { step, since_ns, .. } if now.saturating_sub(since_ns) > refining::WAIT_NS => {
-                out = self.finish_refine(step, now);
+            Phase::Refining { step, since_ns, .. } if now.saturating_sub(since_ns) > super::WAIT_NS => {
+                self.finish_refine(step, now, sequel)
             }
-            Phase::Looking { .. } | Phase::Refining { .. } | Phase::Done(_) => {}
+            Phase::Looking { .. } | Phase::Refining { .. } | Phase::Done(_) => Vec::new(),
         }
-        let running = !matches!(self.phase, Phase::Done(_));
-        if running && now.saturating_sub(self.start_ns) as f64 > self.mission.timeout_s * 1e9 {
-            let enough = self.behaviour.as_ref().is_some_and(|b| b.enough_at_timeout());
-            self.phase = Phase::Done(if enough { MissionState::Succeeded } else { MissionState::Failed });
-            out.push(Output::Command(MotionCommand {
-                header: Header::new(u64::from(self.next_id), now),
-                kind: CommandKind::Stop as u32,
-                command_id: self.next_id,
-                ..Default::default()
-            }));
-        }
-        out.push(Output::Status(self.status(now)));
-        out
     }
 }

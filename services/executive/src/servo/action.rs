@@ -87,7 +87,7 @@ mod tests {
 
     #[test]
     fn servoing_holds_the_line_where_open_loop_drifts_off_it() {
-        let inch = 0.0254;
+        let inch = harvey_geometry::INCH;
         let open = run(false, 0.0);
         let servoed = run(true, 0.001);
         let worst = servoed.iter().fold(0.0f64, |m, d| m.max(d.abs()));

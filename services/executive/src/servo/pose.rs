@@ -175,7 +175,7 @@ fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
 mod tests {
     use super::*;
 
-    const INCH: f64 = 0.0254;
+    use harvey_geometry::INCH;
 
     fn cam() -> PinholeCamera {
         PinholeCamera { focal_px: 554.0, centre_px: [320.0, 240.0], height_m: 1.2 }

@@ -19,7 +19,7 @@ fn goal() -> PtransGoal {
 }
 
 fn hallway() -> World {
-    harvey_world::load_str(include_str!("../../../../worlds/hallway.toml"), "hallway").expect("world")
+    harvey_world::load_str(include_str!("../../../../../worlds/hallway.toml"), "hallway").expect("world")
 }
 
 /// Runs the plan on a robot that falls `loss` short of every move while odometry says it

@@ -1,0 +1,16 @@
+//! The acceptor-sequenced behaviours a mission may run instead of a script or a plan (004): a
+//! finite state acceptor (`fsa.rs`, its bookkeeping in `sequenced.rs`) picks each tick's
+//! perceptual algorithm, and motor schemas (`schemas.rs`, on the robot in `drive.rs`) drive.
+//! Docking (`docking.rs`, the pose from the dock in `dock_pose.rs`) and the pole hunt
+//! (`pole_hunt.rs`) behind one face (`behaviour.rs`).
+
+pub mod behaviour;
+pub mod dock_pose;
+pub mod docking;
+pub mod drive;
+pub mod fsa;
+pub mod pole_hunt;
+pub mod schemas;
+pub mod sequenced;
+
+pub use behaviour::{Behaviour, Run};
