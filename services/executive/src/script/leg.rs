@@ -191,21 +191,28 @@ impl Leg {
     }
 }
 
+/// The tests' servoing set-up: a landmark 16 m down the line, 0.2 m to its left, at the
+/// camera's height (also the script runner's tests').
+#[cfg(test)]
+pub(crate) fn test_setup() -> ServoSetup {
+    ServoSetup {
+        landmark_index: 7,
+        point: [16.0, 0.2, 2.3],
+        offset: [0.0, 0.2, 0.1],
+        params: ServoParams { focal_px: 554.0, misalignment_rad: 0.0, aim_m: 1.2 },
+        width_px: 640,
+        height_px: 480,
+        camera_height_m: 2.3,
+        tracking: Tracking::Increment,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn setup() -> ServoSetup {
-        ServoSetup {
-            landmark_index: 7,
-            point: [16.0, 0.2, 2.3],
-            offset: [0.0, 0.2, 0.1],
-            params: ServoParams { focal_px: 554.0, misalignment_rad: 0.0, aim_m: 1.2 },
-            width_px: 640,
-            height_px: 480,
-            camera_height_m: 2.3,
-            tracking: Tracking::Increment,
-        }
+        test_setup()
     }
 
     #[test]

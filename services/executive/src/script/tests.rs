@@ -6,10 +6,9 @@ use harvey_msgs::{
     VisionStatus,
 };
 
-use super::leg::{ServoSetup, Tracking};
+use super::leg::Tracking;
 use super::{Script, WAIT_NS};
 use crate::mission::{Servo, Step};
-use crate::servo::ServoParams;
 use crate::servo::pose::{PinholeCamera, RefineParams};
 use crate::servo::vertices::RefineSetup;
 use crate::{Executive, Mode, Output};
@@ -101,16 +100,7 @@ fn an_open_loop_move_is_driven_in_its_increments_the_last_taking_what_is_left() 
 
 /// A leg servoed on a landmark 16 m down the line, 0.2 m to its left, at the camera's height.
 fn servoed() -> Executive {
-    let setup = ServoSetup {
-        landmark_index: 7,
-        point: [16.0, 0.2, 2.3],
-        offset: [0.0, 0.2, 0.1],
-        params: ServoParams { focal_px: 554.0, misalignment_rad: 0.0, aim_m: 1.2 },
-        width_px: 640,
-        height_px: 480,
-        camera_height_m: 2.3,
-        tracking: Tracking::Increment,
-    };
+    let setup = super::leg::test_setup();
     let table = Servo {
         aim_m: 1.2,
         misalignment_deg: 0.0,
