@@ -48,6 +48,7 @@ const PIPELINE: &str = r#"
 [launch]
 name = "restart-test"
 grace_period_ms = 2000
+end_with = "encoders"
 
 [[service]]
 name = "sim-drv"
@@ -231,7 +232,7 @@ fn a_crash_looping_service_exhausts_its_restarts_and_ends_the_launch() {
 fn a_service_ignoring_sigterm_is_killed_after_the_grace_period_with_its_helpers() {
     let prefix = common::unique_prefix("grace");
     let dir = common::scratch("grace");
-    let text = "[launch]\nname = \"grace\"\ngrace_period_ms = 300\n\n[[service]]\nname = \"stubborn\"\nbinary = \"/bin/sh\"\nargs = [\"-c\", \"trap '' TERM; echo READY >&3; sleep 100; true\"]\n";
+    let text = "[launch]\nname = \"grace\"\ngrace_period_ms = 300\nend_with = \"stubborn\"\n\n[[service]]\nname = \"stubborn\"\nbinary = \"/bin/sh\"\nargs = [\"-c\", \"trap '' TERM; echo READY >&3; sleep 100; true\"]\n";
     let sup = launch(&write_launch(&dir, text), &prefix, &dir);
     let deadline = Instant::now() + Duration::from_secs(20);
     // The shell and its `sleep` both carry the bus prefix in their environment.

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use harvey_recording::data_files::is_plain_relative;
 use serde::Deserialize;
 
+use crate::bounds::{MAX_SERVICES, Refused, check_service, check_settings, offset_of};
 use crate::config::{ClockMode, Service, Settings};
 
 #[derive(Debug, Deserialize)]
@@ -78,6 +79,13 @@ impl LaunchFile {
         if parsed.services.is_empty() {
             return Err(LaunchError { file, line: None, detail: "no [[service]] to launch".into() });
         }
+        if parsed.services.len() > MAX_SERVICES {
+            let n = parsed.services.len();
+            return Err(at(
+                parsed.services[MAX_SERVICES].name.span().start,
+                format!("key `service[{MAX_SERVICES}]`: {n} services, more than the {MAX_SERVICES} allowed"),
+            ));
+        }
         for (i, s) in parsed.services.iter().enumerate() {
             let name = s.name();
             if name.is_empty() || !name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_') {
@@ -95,18 +103,24 @@ impl LaunchFile {
                     ),
                 ));
             }
-            if !greater(s.restart_window_s, 0.0) || s.backoff_ms == 0 || s.backoff_max_ms < s.backoff_ms {
-                return Err(at(
-                    s.name.span().start,
-                    format!(
-                        "service `{name}`: restart_window_s and backoff_ms must be positive, backoff_max_ms >= backoff_ms"
-                    ),
-                ));
-            }
         }
-        if let Some(end) = &parsed.launch.end_with
-            && !parsed.services.iter().any(|s| s.name() == end.get_ref())
-        {
+        let refused = |r: Refused| LaunchError {
+            file: file.clone(),
+            line: Some(line_of(text, offset_of(text, &r))),
+            detail: format!("key `{}`: {}", r.path(), r.detail),
+        };
+        check_settings(&parsed.launch).map_err(refused)?;
+        for (i, s) in parsed.services.iter().enumerate() {
+            check_service(i, s).map_err(refused)?;
+        }
+        let Some(end) = &parsed.launch.end_with else {
+            return Err(LaunchError {
+                file,
+                line: None,
+                detail: "key `launch.end_with`: missing: name the service whose exit ends the launch".into(),
+            });
+        };
+        if !parsed.services.iter().any(|s| s.name() == end.get_ref()) {
             return Err(at(
                 end.span().start,
                 format!("key `launch.end_with`: no service is named `{}`", end.get_ref()),
@@ -169,11 +183,6 @@ impl LaunchFile {
     }
 }
 
-/// `v > min`, false for NaN: the check that a number is usable.
-fn greater(v: f64, min: f64) -> bool {
-    v > min
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -196,7 +205,7 @@ mod tests {
 
     #[test]
     fn the_clock_chain_starts_at_the_master_and_skips_non_parties() {
-        let text = "[launch]\nname = \"t\"\nclock = \"lockstep\"\nclock_master = \"c\"\n\n[[service]]\nname = \"a\"\n\n[[service]]\nname = \"b\"\nclock_party = false\n\n[[service]]\nname = \"c\"\n\n[[service]]\nname = \"d\"\n";
+        let text = "[launch]\nname = \"t\"\nclock = \"lockstep\"\nclock_master = \"c\"\nend_with = \"a\"\n\n[[service]]\nname = \"a\"\n\n[[service]]\nname = \"b\"\nclock_party = false\n\n[[service]]\nname = \"c\"\n\n[[service]]\nname = \"d\"\n";
         let l = parse(text).expect("parses");
         assert_eq!(l.clock_chain(), ["c", "d", "a"]);
         let e =

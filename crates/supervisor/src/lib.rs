@@ -7,6 +7,7 @@
 //! - `child`: the thin spawn layer (process group, readiness pipe, PDEATHSIG, prefixed logs,
 //!   stop with grace); `supervise`: the loop that ties them together.
 
+pub mod bounds;
 mod child;
 mod clock;
 pub mod config;

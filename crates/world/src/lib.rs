@@ -2,13 +2,17 @@
 //! statistics, the robot's sonar and drive, and the camera; loaded from TOML and ray cast.
 //!
 
+mod bounds;
+mod bounds_topology;
 mod camera;
 mod check;
 mod load;
 mod model;
 mod movers;
 mod poles;
+mod range;
 mod raycast;
+mod spans;
 pub mod topology;
 
 pub use camera::project_with;

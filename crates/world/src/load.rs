@@ -1,8 +1,11 @@
 //! Loading a world file: TOML parsing with errors that name file, line and field, then the
-//! checks (`check.rs`) that the numbers make a world.
+//! ranges of its numbers (`bounds.rs`) and the checks (`check.rs`) that they make a world.
 
 use crate::World;
+use crate::bounds::check_bounds;
 use crate::check::{Inconsistency, check};
+use crate::range::OutOfRange;
+use crate::spans::{line_of, line_of_key};
 
 /// Why a world could not be loaded.
 #[derive(Debug, thiserror::Error)]
@@ -11,13 +14,21 @@ pub enum WorldError {
     Io { file: String, detail: String },
     #[error("{file}:{line}: field `{field}`: {detail}")]
     Parse { file: String, line: usize, field: String, detail: String },
+    /// A number outside its range, or a list longer than its cap (`bounds.rs`): the key, and
+    /// the line where the file gives it (0 when the file leaves it to its default).
+    #[error("{file}:{line}: field `{field}`: {detail}")]
+    OutOfRange { file: String, line: usize, field: String, detail: String },
     /// Parsed, but the numbers make no world (or no mover): [`Inconsistency`] says why.
     #[error("{file}: inconsistent world: {why}")]
     Inconsistent { file: String, why: Inconsistency },
 }
 
-fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
+impl WorldError {
+    /// `why` as the error of `file`, with the line of its key in `text`.
+    pub(crate) fn out_of_range(text: &str, file: &str, why: OutOfRange) -> WorldError {
+        let line = line_of_key(text, &why.key);
+        WorldError::OutOfRange { file: file.to_owned(), line, field: why.key.to_string(), detail: why.detail }
+    }
 }
 
 /// Parses a world from `text`; `file` names it in errors.
@@ -29,6 +40,7 @@ pub fn load_str(text: &str, file: &str) -> Result<World, WorldError> {
         let line = inner.span().map_or(0, |s| line_of(text, s.start));
         WorldError::Parse { file: file.to_owned(), line, field, detail: inner.message().to_owned() }
     })?;
+    check_bounds(&world).map_err(|why| WorldError::out_of_range(text, file, why))?;
     check(&world).map_err(|why| WorldError::Inconsistent { file: file.to_owned(), why })?;
     Ok(world)
 }

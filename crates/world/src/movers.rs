@@ -5,6 +5,9 @@
 
 use serde::Deserialize;
 
+use crate::bounds::{FRACTION, POSITION};
+use crate::range::{OutOfRange, Range, check, check_all, check_len};
+use crate::spans::{KeyPath, line_of};
 use crate::{Inconsistency, Wall, World, WorldError};
 
 /// One moving thing.
@@ -38,25 +41,38 @@ impl Mover {
     }
 }
 
+/// The launch file as far as movers go: other tables are other services' business.
 #[derive(Deserialize)]
 struct File {
     #[serde(default, rename = "mover")]
     movers: Vec<Mover>,
 }
 
+/// How many movers a launch file may hold, and corners and waypoints each: the simulator and
+/// the camera turn every corner into a wall each tick and search the path each tick.
+const MAX_MOVERS: usize = 1_000;
+const MAX_CORNERS: usize = 1_000;
+const MAX_WAYPOINTS: usize = 10_000;
+/// Path times: simulated seconds, up to some four months either way.
+const TIME: Range = Range::within(1e7, "s");
+
 /// The `[[mover]]` tables of a launch file (other tables are other services' business).
 pub fn parse_movers(text: &str, file: &str) -> Result<Vec<Mover>, WorldError> {
     let bad = |why: Inconsistency| WorldError::Inconsistent { file: file.to_owned(), why };
-    let doc: toml::Table = toml::from_str(text)
-        .map_err(|e| WorldError::Io { file: file.to_owned(), detail: e.message().to_owned() })?;
-    let only: toml::Table = doc.into_iter().filter(|(k, _)| k == "mover").collect();
-    let parsed: File = serde_path_to_error::deserialize(only).map_err(|e| WorldError::Parse {
-        file: file.to_owned(),
-        line: 0,
-        field: e.path().to_string(),
-        detail: e.inner().message().to_owned(),
+    let parsed: File = serde_path_to_error::deserialize(toml::Deserializer::new(text)).map_err(|e| {
+        let field = e.path().to_string();
+        let inner = e.into_inner();
+        let line = inner.span().map_or(0, |s| line_of(text, s.start));
+        WorldError::Parse { file: file.to_owned(), line, field, detail: inner.message().to_owned() }
     })?;
-    for m in &parsed.movers {
+    let movers = KeyPath::default().key("mover");
+    check_len(&movers, parsed.movers.len(), MAX_MOVERS, "movers")
+        .map_err(|why| WorldError::out_of_range(text, file, why))?;
+    for (i, m) in parsed.movers.iter().enumerate() {
+        check_mover(&movers.index(i), m).map_err(|mut why| {
+            why.detail = format!("mover {}: {}", m.name, why.detail);
+            WorldError::out_of_range(text, file, why)
+        })?;
         let finite = m.outline.iter().flatten().chain(m.path.iter().flatten()).all(|v| v.is_finite());
         if m.outline.len() < 3 || m.path.is_empty() || !finite {
             return Err(bad(Inconsistency::MoverShape { mover: m.name.clone() }));
@@ -69,6 +85,24 @@ pub fn parse_movers(text: &str, file: &str) -> Result<Vec<Mover>, WorldError> {
         }
     }
     Ok(parsed.movers)
+}
+
+/// Every number of the mover at `k` in its range, its lists within their caps.
+fn check_mover(k: &KeyPath, m: &Mover) -> Result<(), OutOfRange> {
+    check_len(&k.key("outline"), m.outline.len(), MAX_CORNERS, "corners")?;
+    for (i, c) in m.outline.iter().enumerate() {
+        check_all(&k.key("outline").index(i), c, &POSITION)?;
+    }
+    check(&k.key("height_m"), m.height_m, &Range::above(0.0, 100.0, "m"))?;
+    check(&k.key("reflectance"), m.reflectance, &FRACTION)?;
+    check_len(&k.key("path"), m.path.len(), MAX_WAYPOINTS, "waypoints")?;
+    for (i, [t, x, y]) in m.path.iter().enumerate() {
+        let p = k.key("path").index(i);
+        check(&p.index(0), *t, &TIME)?;
+        check(&p.index(1), *x, &POSITION)?;
+        check(&p.index(2), *y, &POSITION)?;
+    }
+    Ok(())
 }
 
 /// [`parse_movers`] on a file.

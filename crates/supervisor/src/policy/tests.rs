@@ -141,9 +141,21 @@ fn a_failed_start_does_not_forget_old_failures() {
 
 #[test]
 fn the_window_comes_from_the_launch_file_and_never_panics() {
-    let text =
-        "[launch]\nname = \"t\"\n\n[[service]]\nname = \"a\"\nrestart_window_s = 1e300\nbackoff_ms = 7\n";
-    let lf = crate::LaunchFile::parse(text, std::path::Path::new("m.toml")).expect("parses");
+    let text = "[launch]\nname = \"t\"\nend_with = \"a\"\n\n[[service]]\nname = \"a\"\nrestart_window_s = 1e300\nbackoff_ms = 7\n";
+    let e = crate::LaunchFile::parse(text, std::path::Path::new("m.toml")).expect_err("a window of 1e300 s");
+    assert!(
+        e.to_string().starts_with("m.toml:7: key `service[0].restart_window_s`: 1e300 is outside"),
+        "{e}"
+    );
+    let mut lf = crate::LaunchFile::parse(&text.replace("1e300", "60"), std::path::Path::new("m.toml"))
+        .expect("parses");
     let r = lf.services[0].restart_rules();
-    assert_eq!((r.mode, r.max_restarts, r.window, r.backoff_ms), (Restart::OnFailure, 5, Duration::MAX, 7));
+    assert_eq!(
+        (r.mode, r.max_restarts, r.window, r.backoff_ms),
+        (Restart::OnFailure, 5, Duration::from_secs(60), 7)
+    );
+    // Built by a program rather than read from a file, a window too long for a Duration never
+    // expires.
+    lf.services[0].restart_window_s = 1e300;
+    assert_eq!(lf.services[0].restart_rules().window, Duration::MAX);
 }
