@@ -61,6 +61,9 @@ enum Cmd {
         #[arg(short, long)]
         output: PathBuf,
     },
+    /// Run a mission over seeds x sensor conditions in parallel and tabulate its figure
+    /// (DIR/sweep.csv, sweep.md, sweep.png); exit 1 if a run failed, 130 if interrupted.
+    Sweep(cmd::sweep::SweepArgs),
 }
 
 fn main() {
@@ -103,5 +106,6 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
         Cmd::Diff { a, b } => cmd::diff::run(&a, &b),
         Cmd::Recover { recording, output } => cmd::recover::run(&recording, &output),
         Cmd::Export { recording, output } => cmd::export::run(&recording, &output),
+        Cmd::Sweep(args) => cmd::sweep::run(&args),
     }
 }

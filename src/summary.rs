@@ -42,6 +42,27 @@ pub struct RunStats {
     /// In a world with `[poles]`: when the true path first came by each pole (code order), and
     /// how close counts.
     pub pole_visits: Option<(Vec<Option<f64>>, f64)>,
+    /// The largest distance of the true path from the line through its first pose along that
+    /// pose's heading (000 §5.5's offset from the line); `None` without `sim/truth`.
+    pub line_offset_m: Option<f64>,
+}
+
+/// A run's figures as data (`harvey sweep` tabulates them): the numbers the mission summary
+/// prints, computed the same way.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Figures {
+    /// The last executive status's state; `None` when none was recorded.
+    pub state: Option<MissionState>,
+    /// Simulated time of the last status, s.
+    pub end_s: Option<f64>,
+    /// The summary's "final error … from the goal" (not for a pole hunt).
+    pub final_error_m: Option<f64>,
+    pub line_offset_m: Option<f64>,
+    /// Poles visited and poles in the field.
+    pub poles: Option<(usize, usize)>,
+    /// The acceptor's states (empty without a sequenced behaviour) and what it achieved.
+    pub trace: Vec<u32>,
+    pub achieved: u32,
 }
 
 impl RunStats {
@@ -49,6 +70,8 @@ impl RunStats {
         let recording = Recording::open(path)?;
         let mut run = RunStats::default();
         let mut true_path: Vec<(f64, [f64; 2])> = Vec::new();
+        // The line of `line_offset_m`: the first true pose's x, y, cos and sin of its heading.
+        let mut line: Option<[f64; 4]> = None;
         for m in recording.messages()? {
             let m = m?;
             let topic = m.topic().to_owned();
@@ -65,6 +88,12 @@ impl RunStats {
                     let t: TruePose = m.decode()?;
                     let p = t.world_from_robot;
                     true_path.push((t.header.stamp_ns as f64 / 1e9, [p.x_m, p.y_m]));
+                    let [x0, y0, c, s] = *line.get_or_insert_with(|| {
+                        let (s, c) = p.heading_rad.sin_cos();
+                        [p.x_m, p.y_m, c, s]
+                    });
+                    let off = (-(p.x_m - x0) * s + (p.y_m - y0) * c).abs();
+                    run.line_offset_m = Some(run.line_offset_m.map_or(off, |m: f64| m.max(off)));
                     run.last_truth = Some(t);
                 }
                 "ums/map" => run.last_map = Some(m.decode()?),
@@ -131,6 +160,26 @@ impl RunStats {
             (last - first) as f64 / 1e9
         );
         out
+    }
+
+    /// The figures of [`Self::mission_summary`] as data.
+    pub fn figures(&self) -> Figures {
+        let mut f = Figures {
+            state: self.last_status.as_ref().and_then(MissionStatus::state),
+            end_s: self.last_status.as_ref().map(|s| s.header.stamp_ns as f64 / 1e9),
+            line_offset_m: self.line_offset_m,
+            trace: self.fsa_trace.clone(),
+            achieved: self.achieved,
+            ..Figures::default()
+        };
+        if let (Some(s), Some(t), None) = (&self.last_status, &self.last_truth, &self.pole_visits) {
+            let (g, p) = (s.goal, t.world_from_robot);
+            f.final_error_m = Some((p.x_m - g.x_m).hypot(p.y_m - g.y_m));
+        }
+        if let Some((visits, _)) = &self.pole_visits {
+            f.poles = Some((visits.iter().flatten().count(), visits.len()));
+        }
+        f
     }
 
     /// The mission summary `harvey run` prints.
@@ -200,5 +249,29 @@ impl RunStats {
             s.sonar_rings_seen, s.detections_seen, s.maps_seen
         );
         out
+    }
+}
+
+#[cfg(test)]
+#[allow(dead_code, reason = "the harness's sample, damage and campaign; its tools are the crate's")]
+#[path = "../crates/recording/tests/mutation/mod.rs"]
+mod mutation;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mutation::tools::{Case, Output, fingerprint};
+
+    /// What `harvey info` prints for a recording, or `None` for the error it reports.
+    fn info(case: &Case<'_>) -> Result<Output, String> {
+        let stats = RunStats::read(case.mutated).ok();
+        Ok(vec![stats.map(|s| fingerprint(&(s.info_table(), s.mission_summary(), s.pole_visits.is_some())))])
+    }
+
+    #[test]
+    fn info_reports_every_damage_it_reads_and_never_panics() {
+        let c = mutation::campaign("info", info, 400, 7);
+        println!("{}", mutation::table(&[("info", &c)]));
+        mutation::assert_kept("info", &c);
     }
 }

@@ -9,6 +9,7 @@ pub mod recover;
 pub mod replay;
 mod replay_launch;
 pub mod run;
+pub mod sweep;
 
 use std::path::{Path, PathBuf};
 
