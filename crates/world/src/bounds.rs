@@ -2,9 +2,9 @@
 //! loaded, before the consistency checks (`check.rs`) and before any service uses a number.
 //! Each range is stated where it is checked; the shipped worlds sit well inside all of them.
 
-use crate::range::{OutOfRange, Range, check, check_all, check_len};
-use crate::spans::{KeyPath, Step};
 use crate::{Region, Terrain, Wall, World};
+use harvey_config::range::{OutOfRange, Range, check, check_all, check_len};
+use harvey_config::spans::{KeyPath, Step};
 
 /// Positions (walls, outlines, landmarks, doors, the start): a world of at most 10 km either way
 /// from its origin. Larger numbers are typing mistakes, and 1e308 would make every distance

@@ -2,9 +2,9 @@
 //! `[poles]`: the part of `bounds.rs` that is not walls, robot and camera.
 
 use crate::bounds::{FRACTION, MAX_ITEMS, POLE_COUNT, POSITION};
-use crate::range::{OutOfRange, Range, check, check_all, check_len};
-use crate::spans::KeyPath;
 use crate::{PoleField, World};
+use harvey_config::range::{OutOfRange, Range, check, check_all, check_len};
+use harvey_config::spans::KeyPath;
 
 fn root(key: &'static str) -> KeyPath {
     KeyPath::default().key(key)

@@ -10,9 +10,7 @@ mod load;
 mod model;
 mod movers;
 mod poles;
-mod range;
 mod raycast;
-mod spans;
 pub mod topology;
 
 pub use camera::project_with;

@@ -4,8 +4,8 @@
 use crate::World;
 use crate::bounds::check_bounds;
 use crate::check::{Inconsistency, check};
-use crate::range::OutOfRange;
-use crate::spans::{line_of, line_of_key};
+use harvey_config::range::OutOfRange;
+use harvey_config::spans::{line_of, line_of_key};
 
 /// Why a world could not be loaded.
 #[derive(Debug, thiserror::Error)]

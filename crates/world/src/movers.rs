@@ -6,9 +6,9 @@
 use serde::Deserialize;
 
 use crate::bounds::{FRACTION, POSITION};
-use crate::range::{OutOfRange, Range, check, check_all, check_len};
-use crate::spans::{KeyPath, line_of};
 use crate::{Inconsistency, Wall, World, WorldError};
+use harvey_config::range::{OutOfRange, Range, check, check_all, check_len};
+use harvey_config::spans::{KeyPath, line_of};
 
 /// One moving thing.
 #[derive(Debug, Clone, PartialEq, Deserialize)]

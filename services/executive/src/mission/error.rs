@@ -11,6 +11,10 @@ pub enum MissionError {
     Field { file: String, path: String, message: String },
     #[error("{file}: no [mission] table")]
     NoMission { file: String },
+    /// A number outside its range, or a list longer than its cap (`bounds.rs`): the key as the
+    /// file spells it, and the line where the file gives it (0 when it is left to its default).
+    #[error("{file}:{line}: key `{key}`: {detail}")]
+    OutOfRange { file: String, line: usize, key: String, detail: String },
     #[error("{file}: mission.timeout_s must be positive")]
     Timeout { file: String },
     #[error(

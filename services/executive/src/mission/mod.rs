@@ -1,9 +1,13 @@
 //! The mission a launch file gives the executive: a script of TURN and MOVE primitives with a
 //! time limit, a move perhaps driven in increments and servoed on a landmark (000 §5.5); or a
 //! goal `(ptrans a b)` that plan-and-monitor develops over the world's locale graph (000 §2).
+//! Every number is checked against its range first (`bounds.rs`, refusals naming file, line and
+//! key), then how the table's parts fit together (here and `goals.rs`).
 
 use serde::Deserialize;
 
+mod bounds;
+mod bounds_goals;
 mod error;
 pub mod goals;
 
@@ -103,6 +107,12 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
         message: e.inner().message().to_owned(),
     })?;
     let m = parsed.mission.ok_or_else(|| MissionError::NoMission { file: file_name() })?;
+    bounds::check_bounds(&m).map_err(|why| MissionError::OutOfRange {
+        file: file_name(),
+        line: harvey_config::line_of_key(text, &why.key),
+        key: why.key.to_string(),
+        detail: why.detail,
+    })?;
     if !greater(m.timeout_s, 0.0) {
         return Err(MissionError::Timeout { file: file_name() });
     }

@@ -9,7 +9,7 @@ use serde::de::{Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
 
 /// One step of a key path: a table's key or an array's index.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub(crate) enum Step {
+pub enum Step {
     Key(&'static str),
     /// A key chosen by the file (a terrain's name).
     Name(String),
@@ -18,21 +18,21 @@ pub(crate) enum Step {
 
 /// A key path, shown as the file spells it: `terrain.tile.drift_deg_per_ft`, `wall[0].from[1]`.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
-pub(crate) struct KeyPath(pub(crate) Vec<Step>);
+pub struct KeyPath(pub Vec<Step>);
 
 impl KeyPath {
     /// This path, one step further.
-    pub(crate) fn then(&self, step: Step) -> KeyPath {
+    pub fn then(&self, step: Step) -> KeyPath {
         let mut steps = self.0.clone();
         steps.push(step);
         KeyPath(steps)
     }
 
-    pub(crate) fn key(&self, key: &'static str) -> KeyPath {
+    pub fn key(&self, key: &'static str) -> KeyPath {
         self.then(Step::Key(key))
     }
 
-    pub(crate) fn index(&self, i: usize) -> KeyPath {
+    pub fn index(&self, i: usize) -> KeyPath {
         self.then(Step::Index(i))
     }
 }
@@ -172,13 +172,13 @@ impl<'de> Visitor<'de> for LocatedVisitor {
 }
 
 /// The 1-based line at byte `offset` of `text`.
-pub(crate) fn line_of(text: &str, offset: usize) -> usize {
+pub fn line_of(text: &str, offset: usize) -> usize {
     text[..offset.min(text.len())].bytes().filter(|&b| b == b'\n').count() + 1
 }
 
 /// The line of the value at `path` in `text`; if the path goes further than the file (a value
 /// left to its default), the line of the deepest part of it that is there; 0 if none is.
-pub(crate) fn line_of_key(text: &str, path: &KeyPath) -> usize {
+pub fn line_of_key(text: &str, path: &KeyPath) -> usize {
     let Ok(root) = toml::from_str::<Node>(text) else { return 0 };
     let mut node = &root;
     let mut at = None;
