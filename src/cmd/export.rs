@@ -4,6 +4,8 @@
 use std::path::Path;
 
 pub fn run(recording: &Path, output: &Path) -> anyhow::Result<i32> {
+    // Refused before anything is read or written.
+    harvey_recording::same_file::refuse_overwrite(recording, output)?;
     // A progress bar for people; logs get only the result line.
     let mut shown = if std::io::IsTerminal::is_terminal(&std::io::stderr()) { 0 } else { u64::MAX };
     let drawn = harvey_recording::export::export(recording, output, |done, total| {

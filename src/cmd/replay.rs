@@ -1,14 +1,22 @@
 //! `harvey replay RECORDING [--check]`: run a recording's services again on its recorded inputs
 //! and record them again; `--check` compares the new recording with the old.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use super::replay_launch::prepare;
+use harvey_recording::Recording;
+use harvey_recording::same_file::same_file;
+
+use super::replay_launch::{LAUNCH_FILE, prepare};
 use super::{LaunchArgs, launch_file, report_comparison};
+
+/// The files a replay writes into its run folder besides the data files the recording carries:
+/// the new recording and Rerun file (as the launches name them), the world and the launch.
+const WRITTEN: [&str; 4] = ["run.mcap", "run.rrd", "world.toml", LAUNCH_FILE];
 
 pub fn run(recording: &Path, check: bool, rrd: bool, opts: LaunchArgs) -> anyhow::Result<i32> {
     let run_dir =
         opts.run_dir.clone().unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
+    refuse_writing_over(recording, &run_dir)?;
     let file = prepare(recording, &run_dir, rrd)?;
     let (outcome, _) = launch_file(&file, &LaunchArgs { run_dir: Some(run_dir.clone()), ..opts })?;
     println!("replay: {outcome:?}");
@@ -19,4 +27,58 @@ pub fn run(recording: &Path, check: bool, rrd: bool, opts: LaunchArgs) -> anyhow
     }
     let c = harvey_recording::compare::compare(recording, &again, &|_| true)?;
     Ok(report_comparison(&c, recording, &again))
+}
+
+/// An error, before anything is written, when the recording is one of the files the replay would
+/// write into `run_dir` (by any name: a symlink, a hard link).
+fn refuse_writing_over(recording: &Path, run_dir: &Path) -> anyhow::Result<()> {
+    // Nothing in a folder that does not exist yet can be the recording.
+    if !run_dir.is_dir() {
+        return Ok(());
+    }
+    let mut written: Vec<PathBuf> = WRITTEN.iter().map(|name| run_dir.join(name)).collect();
+    // The data files' names are checked (and refused when they escape) by `prepare`.
+    let rec = Recording::open(recording)?;
+    if let Ok(files) = rec.data_files() {
+        written.extend(files.flatten().map(|f| run_dir.join(f.name)));
+    }
+    if let Some(file) = written.iter().find(|file| same_file(recording, file)) {
+        anyhow::bail!(
+            "the replay would overwrite {} (as {}): choose another --run-dir",
+            recording.display(),
+            file.display()
+        );
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_replay_never_writes_into_the_recording_it_replays() {
+        let dir = std::env::temp_dir().join(format!("harvey-replay-over-{}", std::process::id()));
+        std::fs::create_dir_all(dir.join("fsa")).expect("tmp");
+        let recording = dir.join("source.mcap");
+        let mut r = harvey_recording::Recorder::create(&recording).expect("create");
+        r.attach_launch("l.toml", "[launch]\nname = \"l\"\nfiles = [\"fsa/t.toml\"]\n").expect("launch");
+        r.attach_data("fsa/t.toml", b"x").expect("data");
+        r.finish().expect("finish");
+        assert!(refuse_writing_over(&recording, &dir.join("elsewhere")).is_ok(), "no such folder yet");
+        assert!(refuse_writing_over(&recording, &dir).is_ok(), "source.mcap is not written");
+        for (name, written) in
+            [("run.mcap", "run.mcap"), ("world.toml", "world.toml"), ("fsa/t.toml", "fsa/t.toml")]
+        {
+            std::os::unix::fs::symlink(&recording, dir.join(name)).expect("link");
+            let e = refuse_writing_over(&recording, &dir).expect_err(name).to_string();
+            assert!(
+                e.contains("would overwrite")
+                    && e.ends_with(&format!("{written}): choose another --run-dir")),
+                "{e}"
+            );
+            std::fs::remove_file(dir.join(name)).expect("unlink");
+        }
+        std::fs::remove_dir_all(&dir).ok();
+    }
 }

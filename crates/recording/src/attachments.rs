@@ -7,6 +7,7 @@ use std::borrow::Cow;
 use harvey_world::{Pole, World};
 
 use crate::data_files::{DATA_MEDIA_TYPE, is_plain_relative};
+use crate::summary::{Located, attachment, metadata};
 use crate::{
     LAUNCH_MEDIA_TYPE, RECORDER_METADATA, Recording, RecordingError, WORLD_MEDIA_TYPE, WORLD_METADATA,
 };
@@ -27,10 +28,8 @@ impl Recording {
             .iter()
             .find(|a| a.media_type == media_type)
             .ok_or_else(|| RecordingError::NoAttachment { file: file(), media_type })?;
-        let a = mcap::read::attachment(self.bytes(), index).map_err(|cause| RecordingError::Attachment {
-            file: file(),
-            name: index.name.clone(),
-            cause,
+        let a = attachment(self.bytes(), index).map_err(|Located { offset, what }| {
+            RecordingError::Attachment { file: file(), name: index.name.clone(), offset, what }
         })?;
         let text = std::str::from_utf8(&a.data).map_err(|cause| RecordingError::NotText {
             file: file(),
@@ -62,25 +61,28 @@ impl Recording {
             if !is_plain_relative(&name) {
                 return Err(RecordingError::DataName { file, name });
             }
-            match mcap::read::attachment(self.bytes(), index) {
+            match attachment(self.bytes(), index) {
                 Ok(a) => Ok(DataFile { name, data: a.data }),
-                Err(cause) => Err(RecordingError::Attachment { file, name, cause }),
+                Err(Located { offset, what }) => Err(RecordingError::Attachment { file, name, offset, what }),
             }
         }))
     }
 
     /// The world the recording carries, with its `[poles]` placed by the recorded seed (1 when
     /// the recording predates the `harvey.world` record, as the recorder's default), and those
-    /// poles; `None` without a world attachment (or without a summary to find it by). A world
-    /// attachment that does not load is an error naming it.
+    /// poles; `None` without a world attachment (or when the footer says there is no summary to
+    /// find it by). A summary that does not read (or no footer: a writer killed), a data section
+    /// whose CRC does not check (what vouches for the seed's metadata record) and a world
+    /// attachment that does not load are errors naming them.
     pub fn world(&self) -> Result<Option<(World, Vec<Pole>)>, RecordingError> {
-        let Some(summary) = self.summary_if_any() else { return Ok(None) };
+        let Some(summary) = self.summary_state()? else { return Ok(None) };
         let Some(index) = summary.attachment_indexes.iter().find(|a| a.media_type == WORLD_MEDIA_TYPE) else {
             return Ok(None);
         };
         let file = || self.path().to_owned();
-        let att = mcap::read::attachment(self.bytes(), index)
-            .map_err(|cause| RecordingError::Attachment { file: file(), name: index.name.clone(), cause })?;
+        let att = attachment(self.bytes(), index).map_err(|Located { offset, what }| {
+            RecordingError::Attachment { file: file(), name: index.name.clone(), offset, what }
+        })?;
         let text = std::str::from_utf8(&att.data).map_err(|cause| RecordingError::NotText {
             file: file(),
             name: att.name.clone(),
@@ -90,10 +92,9 @@ impl Recording {
             .map_err(|cause| RecordingError::World { file: file(), cause })?;
         let mut seed = 1;
         if let Some(m) = summary.metadata_indexes.iter().find(|m| m.name == WORLD_METADATA) {
-            let record = mcap::read::metadata(self.bytes(), m).map_err(|cause| RecordingError::Metadata {
-                file: file(),
-                name: WORLD_METADATA,
-                cause,
+            self.check_data_section()?;
+            let record = metadata(self.bytes(), m).map_err(|Located { offset, what }| {
+                RecordingError::Metadata { file: file(), name: WORLD_METADATA, offset, what }
             })?;
             if let Some(text) = record.metadata.get("seed") {
                 seed = text.parse().map_err(|cause| RecordingError::Seed {
@@ -112,16 +113,21 @@ impl Recording {
     }
 
     /// The sequence numbers the recorder saw skipped, per topic, from its `harvey.recorder`
-    /// records in file order (`None` where a count does not parse); nothing without a summary.
+    /// records in file order (`None` where a count does not parse); nothing when the footer says
+    /// there is no summary, an error when there is none that reads (as [`Recording::world`]).
+    /// Metadata has no CRC of its own: it is read only once the data section's CRC checks.
     pub fn seq_gaps(&self) -> Result<Vec<(String, Option<u64>)>, RecordingError> {
-        let Some(summary) = self.summary_if_any() else { return Ok(Vec::new()) };
+        let Some(summary) = self.summary_state()? else { return Ok(Vec::new()) };
         let mut gaps = Vec::new();
         for idx in summary.metadata_indexes.iter().filter(|i| i.name == RECORDER_METADATA) {
-            let md = mcap::read::metadata(self.bytes(), idx).map_err(|cause| RecordingError::Metadata {
-                file: self.path().to_owned(),
-                name: RECORDER_METADATA,
-                cause,
-            })?;
+            self.check_data_section()?;
+            let md =
+                metadata(self.bytes(), idx).map_err(|Located { offset, what }| RecordingError::Metadata {
+                    file: self.path().to_owned(),
+                    name: RECORDER_METADATA,
+                    offset,
+                    what,
+                })?;
             for (k, v) in &md.metadata {
                 if let Some(topic) = k.strip_suffix(".seq_gaps") {
                     gaps.push((topic.to_owned(), v.parse().ok()));

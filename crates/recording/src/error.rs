@@ -1,11 +1,14 @@
 //! What can go wrong with a recording: every error names the file and says what is wrong with
-//! it. The MCAP side is [`RecordingError`]; the Rerun side is [`crate::rrd::RrdError`]; a launch
-//! file's list of data files is [`crate::data_files::DataFilesError`].
+//! it, a damaged one also where (the byte offset and the [`Damage`]). The MCAP side is
+//! [`RecordingError`]; the Rerun side is [`crate::rrd::RrdError`]; a launch file's list of data
+//! files is [`crate::data_files::DataFilesError`].
 
 use std::error::Error;
 use std::path::PathBuf;
 
 use harvey_cdr::CdrError;
+
+use crate::damage::Damage;
 
 /// `e` and the errors beneath it, `: `-separated (what `anyhow`'s `{:#}` prints), so that a
 /// cause's own cause is not lost when it is shown inside another message.
@@ -30,21 +33,28 @@ pub enum RecordingError {
     #[error("recording {file}: {cause}")]
     Create { file: PathBuf, cause: std::io::Error },
 
-    // Writing (`writer.rs`, `recover.rs`).
+    // Writing (`writer.rs`, `recover.rs`, `export.rs`).
     /// The MCAP writer failed.
     #[error("recording {file}: {}", chain(cause))]
     Write { file: PathBuf, cause: mcap::McapError },
 
-    // Reading messages (`reader.rs`, `ticks.rs`).
-    /// The file does not start as an MCAP file does.
-    #[error("{file}: not an MCAP file: {}", chain(cause))]
-    NotMcap { file: PathBuf, cause: mcap::McapError },
-    /// Not even the magic bytes of an MCAP file at the start (what `harvey recover` checks).
+    /// An output path that is the input itself (through a symlink or a hard link too): a tool
+    /// never writes over what it reads.
+    #[error("{output} is {input} itself: refusing to overwrite the recording read")]
+    Overwrite { input: PathBuf, output: PathBuf },
+
+    // Reading messages (`reader.rs`, `stream.rs`, `ticks.rs`).
+    /// Not even the magic bytes of an MCAP file at the start.
     #[error("{file}: not an MCAP file (no magic bytes at the start)")]
     NoMagic { file: PathBuf },
-    /// The messages stop being readable (a writer killed mid-chunk, a damaged file).
-    #[error("{file}: corrupt after {after} messages: {}", chain(cause))]
-    Corrupt { file: PathBuf, after: usize, cause: mcap::McapError },
+    /// The messages stop being readable (a writer killed mid-chunk, a damaged file): the damage,
+    /// and the byte offset of the record it is in.
+    #[error("{file}: corrupt after {after} messages, at byte {offset}: {what}")]
+    Corrupt { file: PathBuf, after: usize, offset: u64, what: Damage },
+    /// The data section does not check (its CRC, or a record that runs past the file): what a
+    /// record without a CRC of its own (metadata) is read only after.
+    #[error("{file}: damaged at byte {offset}: {what}")]
+    Damaged { file: PathBuf, offset: u64, what: Damage },
     /// A recorded message does not decode as its topic's type.
     #[error("{file}: message {index} on /{topic}: {cause}")]
     Decode { file: PathBuf, index: usize, topic: String, cause: CdrError },
@@ -54,17 +64,17 @@ pub enum RecordingError {
 
     // The summary, attachments and metadata (`reader.rs`).
     /// The summary section is there but does not read.
-    #[error("{file}: no readable summary (run `harvey recover` on it first): {}", chain(cause))]
-    BadSummary { file: PathBuf, cause: mcap::McapError },
-    /// No summary section (the writer never finished the file).
+    #[error("{file}: no readable summary (run `harvey recover` on it first): at byte {offset}: {what}")]
+    BadSummary { file: PathBuf, offset: u64, what: Damage },
+    /// No summary section (the writer never finished the file, or the footer says there is none).
     #[error("{file}: no summary (run `harvey recover` on it first)")]
     NoSummary { file: PathBuf },
     /// No attachment of a media type a tool needs.
     #[error("{file}: no `{media_type}` attachment: was it recorded by `harvey run`?")]
     NoAttachment { file: PathBuf, media_type: &'static str },
     /// An attachment does not read.
-    #[error("{file}: attachment `{name}`: {}", chain(cause))]
-    Attachment { file: PathBuf, name: String, cause: mcap::McapError },
+    #[error("{file}: attachment `{name}`, at byte {offset}: {what}")]
+    Attachment { file: PathBuf, name: String, offset: u64, what: Damage },
     /// A text attachment (launch or world file) is not UTF-8.
     #[error("{file}: attachment `{name}` is not text: {cause}")]
     NotText { file: PathBuf, name: String, cause: std::str::Utf8Error },
@@ -72,8 +82,8 @@ pub enum RecordingError {
     #[error("{file}: data attachment `{name}` is not a relative path inside the run folder")]
     DataName { file: PathBuf, name: String },
     /// A metadata record does not read.
-    #[error("{file}: `{name}` metadata: {}", chain(cause))]
-    Metadata { file: PathBuf, name: &'static str, cause: mcap::McapError },
+    #[error("{file}: `{name}` metadata, at byte {offset}: {what}")]
+    Metadata { file: PathBuf, name: &'static str, offset: u64, what: Damage },
     /// The `harvey.world` metadata's seed is not a number.
     #[error("{file}: `{}` metadata: seed `{text}`: {cause}", crate::WORLD_METADATA)]
     Seed { file: PathBuf, text: String, cause: std::num::ParseIntError },

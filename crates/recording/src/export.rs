@@ -5,11 +5,13 @@ use std::path::Path;
 
 use crate::draw::draw_recorded;
 use crate::rrd::RrdWriter;
+use crate::same_file::refuse_overwrite;
 use crate::{Recording, RecordingError};
 
-/// Converts `mcap` to `rrd`, calling `progress(done, total)` as messages go; returns how many
-/// messages were drawn.
+/// Converts `mcap` to `rrd` (which may not be `mcap` itself), calling `progress(done, total)` as
+/// messages go; returns how many messages were drawn.
 pub fn export(mcap: &Path, rrd: &Path, mut progress: impl FnMut(u64, u64)) -> Result<u64, RecordingError> {
+    refuse_overwrite(mcap, rrd)?;
     let recording = Recording::open(mcap)?;
     let total = recording.message_count();
     // The messages are the recording; a world that no longer loads (an older file format, say)

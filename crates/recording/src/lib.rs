@@ -9,20 +9,37 @@
 //! [`Recorder`] writes one, [`Recording`] reads one back; [`compare`], [`recover`] and
 //! [`export`] (to a Rerun file, drawn by [`rrd`]) are the offline tools; [`ticks`] splits a
 //! recording's inputs into the ticks a replay feeds.
+//!
+//! Every reader reads through [`Recording`], which never trusts the bytes: each record's length
+//! is checked against what the file has left and its length fields against its own end before
+//! the mcap crate parses it (`records.rs`, `fields.rs`), each chunk's size against limits and its
+//! CRC before its records are taken (`chunk.rs`), the data and summary sections' CRCs where the
+//! file has them (`stream.rs`, `summary.rs`); a damaged file is an error naming the file, the byte
+//! offset and the [`Damage`], never a panic or an allocation of what a flipped bit claims.
 
 mod attachments;
+mod chunk;
 pub mod compare;
+mod damage;
 pub mod data_files;
 pub mod draw;
 mod error;
 pub mod export;
+mod fields;
 pub mod reader;
+mod records;
 pub mod recover;
 pub mod rrd;
+mod salvage;
+pub mod same_file;
+mod stream;
+mod summary;
 pub mod ticks;
 pub mod writer;
 
 pub use attachments::DataFile;
+pub use chunk::MAX_CHUNK_BYTES;
+pub use damage::Damage;
 pub use data_files::DATA_MEDIA_TYPE;
 pub use error::RecordingError;
 pub use reader::{Message, Recording};

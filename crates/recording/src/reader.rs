@@ -1,6 +1,7 @@
-//! Opening a recording: its messages in file order and its summary section. What the recording
-//! carries besides its messages (launch, world, data files, the recorder's counts) is read in
-//! `attachments.rs`.
+//! Opening a recording: its messages in file order and its summary section, both read through
+//! the crate's checked readers (`stream.rs`, `summary.rs`: lengths, limits, CRCs), which every
+//! tool of the crate reads with. What the recording carries besides its messages (launch, world,
+//! data files, the recorder's counts) is read in `attachments.rs`.
 
 use std::cell::OnceCell;
 use std::path::{Path, PathBuf};
@@ -8,13 +9,20 @@ use std::path::{Path, PathBuf};
 use harvey_cdr::{Cdr, CdrError};
 
 use crate::RecordingError;
+use crate::damage::Damage;
+use crate::records::check_data_crc;
+use crate::stream::Stream;
+use crate::summary::Located;
 
 /// A recording read into memory.
 pub struct Recording {
     path: PathBuf,
     bytes: Vec<u8>,
-    /// The summary section, read when first wanted; `None` when it is missing or unreadable.
-    summary: OnceCell<Option<mcap::Summary>>,
+    /// The summary section, read when first wanted: `Some(None)` when the footer says there is
+    /// none, `None` when it does not read (`summary_error` says why).
+    summary: OnceCell<Option<Option<mcap::Summary>>>,
+    /// Whether the data section's CRC checks, found when first wanted.
+    data_crc: OnceCell<bool>,
 }
 
 impl Recording {
@@ -22,7 +30,7 @@ impl Recording {
     pub fn open(path: &Path) -> Result<Self, RecordingError> {
         let bytes =
             std::fs::read(path).map_err(|cause| RecordingError::Read { file: path.to_owned(), cause })?;
-        Ok(Self { path: path.to_owned(), bytes, summary: OnceCell::new() })
+        Ok(Self { path: path.to_owned(), bytes, summary: OnceCell::new(), data_crc: OnceCell::new() })
     }
 
     /// The file it was read from.
@@ -34,21 +42,46 @@ impl Recording {
         &self.bytes
     }
 
+    /// The summary section if there is one (`None` when the footer says there is none); one that
+    /// does not read, or no footer at all (a writer killed), is an error.
+    pub(crate) fn summary_state(&self) -> Result<Option<&mcap::Summary>, RecordingError> {
+        match self.summary.get_or_init(|| crate::summary::read(&self.bytes).ok()) {
+            Some(summary) => Ok(summary.as_ref()),
+            None => Err(self.summary_error()),
+        }
+    }
+
+    /// Why the summary does not read (read again: errors are the rare path).
+    fn summary_error(&self) -> RecordingError {
+        let file = self.path.clone();
+        match crate::summary::read(&self.bytes) {
+            Err(Located { what: Damage::NoFooter, .. }) | Ok(_) => RecordingError::NoSummary { file },
+            Err(Located { offset, what }) => RecordingError::BadSummary { file, offset, what },
+        }
+    }
+
+    /// Checks the data section's CRC, once: what vouches for the metadata records, which have no
+    /// CRC of their own.
+    pub(crate) fn check_data_section(&self) -> Result<(), RecordingError> {
+        if *self.data_crc.get_or_init(|| check_data_crc(&self.bytes).is_ok()) {
+            return Ok(());
+        }
+        match check_data_crc(&self.bytes) {
+            Ok(()) => Ok(()),
+            Err((offset, what)) => {
+                Err(RecordingError::Damaged { file: self.path.clone(), offset: offset as u64, what })
+            }
+        }
+    }
+
     /// The summary section, if there is one that reads.
     pub(crate) fn summary_if_any(&self) -> Option<&mcap::Summary> {
-        self.summary.get_or_init(|| mcap::Summary::read(&self.bytes).ok().flatten()).as_ref()
+        self.summary_state().ok().flatten()
     }
 
     /// The summary section; its absence is an error that suggests `harvey recover`.
     pub(crate) fn summary(&self) -> Result<&mcap::Summary, RecordingError> {
-        if let Some(summary) = self.summary_if_any() {
-            return Ok(summary);
-        }
-        let file = self.path.clone();
-        Err(match mcap::Summary::read(&self.bytes) {
-            Err(cause) => RecordingError::BadSummary { file, cause },
-            Ok(_) => RecordingError::NoSummary { file },
-        })
+        self.summary_state()?.ok_or_else(|| RecordingError::NoSummary { file: self.path.clone() })
     }
 
     /// How many messages the summary counts (0 without one): the total for a progress bar.
@@ -56,19 +89,21 @@ impl Recording {
         self.summary_if_any().and_then(|s| s.stats.as_ref()).map_or(0, |s| s.message_count)
     }
 
-    /// Every message, in file order. Reading stops at the first that does not read, with an
-    /// error saying how many came before it.
+    /// Every message, in file order, each chunk's CRC checked before its messages come. Reading
+    /// stops at the first damage, with an error saying how many messages came before it and the
+    /// byte offset of the record it is in.
     pub fn messages(&self) -> Result<Messages<'_>, RecordingError> {
-        let stream = mcap::MessageStream::new(&self.bytes)
-            .map_err(|cause| RecordingError::NotMcap { file: self.path.clone(), cause })?;
-        Ok(Messages { file: &self.path, stream, index: 0, done: false })
+        if !self.bytes.starts_with(mcap::MAGIC) {
+            return Err(RecordingError::NoMagic { file: self.path.clone() });
+        }
+        Ok(Messages { file: &self.path, stream: Stream::new(&self.bytes), index: 0, done: false })
     }
 }
 
 /// The messages of a [`Recording`], in file order.
 pub struct Messages<'a> {
     file: &'a Path,
-    stream: mcap::MessageStream<'a>,
+    stream: Stream<'a>,
     index: usize,
     done: bool,
 }
@@ -86,9 +121,9 @@ impl<'a> Iterator for Messages<'a> {
                 self.index += 1;
                 Some(Ok(Message { file: self.file, index, inner }))
             }
-            Err(cause) => {
+            Err(Located { offset, what }) => {
                 self.done = true;
-                Some(Err(RecordingError::Corrupt { file: self.file.to_owned(), after: index, cause }))
+                Some(Err(RecordingError::Corrupt { file: self.file.to_owned(), after: index, offset, what }))
             }
         }
     }
@@ -193,7 +228,7 @@ mod tests {
         let read: Vec<_> = cut.messages().expect("mcap").collect();
         assert_eq!(read.len(), 4, "three messages, then the error");
         let e = read[3].as_ref().err().expect("cut").to_string();
-        assert!(e.contains("cut.mcap: corrupt after 3 messages: "), "{e}");
+        assert!(e.contains("cut.mcap: corrupt after 3 messages, at byte "), "{e}");
         assert!(
             cut.launch_text()
                 .expect_err("no summary")

@@ -1,93 +1,135 @@
-//! `harvey recover`: salvages a recording whose writer died (SIGKILL, power loss) into a valid
-//! MCAP file: every message of every complete chunk, the attachments, in order. What the dead
-//! writer had not yet flushed is gone; how far the salvage got is reported.
+//! `harvey recover`: salvages a recording whose writer died (SIGKILL, power loss) or whose bytes
+//! are damaged into a valid MCAP file: every message of every chunk whose CRC checks (`salvage.rs`),
+//! the attachments whose CRC checks, the metadata, in order. What the dead writer had not yet
+//! flushed is gone, a damaged chunk is skipped (never written again under a fresh CRC); how far
+//! the salvage got, and what it skipped where, is reported.
 
-use std::borrow::Cow;
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::Path;
 
-use enumset::EnumSet;
-use mcap::read::Options;
-use mcap::records::{Metadata, Record};
+use mcap::records::Metadata;
 
-use crate::{RECOVER_METADATA, Recording, RecordingError};
+use crate::same_file::refuse_overwrite;
+use crate::{RECOVER_METADATA, Recording, RecordingError, salvage};
 
 /// What was salvaged.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Salvage {
     pub messages: u64,
     pub attachments: u64,
+    /// File offsets of the chunks skipped: their CRC did not check (or there was none to check
+    /// them by), or their records did not parse or link to a channel.
+    pub damaged_chunks: Vec<u64>,
+    /// File offsets of the other records skipped: attachments whose CRC does not check, records
+    /// that do not parse.
+    pub damaged_records: Vec<u64>,
+    /// The data section's CRC does not match though every chunk and attachment does: a record
+    /// without a CRC of its own (metadata, a message index) is damaged, and was copied.
+    pub bad_data_crc: bool,
     /// Why reading stopped before a proper end, if it did.
     pub stopped_at: Option<String>,
 }
 
-/// Copies what can be read of `input` into a new, complete MCAP file at `output`.
+impl Salvage {
+    /// Whether the input read to its end with nothing skipped and every CRC matching.
+    pub fn is_whole(&self) -> bool {
+        self.damaged_chunks.is_empty()
+            && self.damaged_records.is_empty()
+            && !self.bad_data_crc
+            && self.stopped_at.is_none()
+    }
+
+    /// What was skipped and lost, for the line `harvey recover` prints after its counts: empty
+    /// for a whole input.
+    pub fn losses(&self) -> String {
+        let offsets = |o: &[u64]| o.iter().map(u64::to_string).collect::<Vec<_>>().join(", ");
+        let plural = |n: usize, what: &str| format!("{n} damaged {what}{}", if n == 1 { "" } else { "s" });
+        let mut out = String::new();
+        for (skipped, what) in [(&self.damaged_chunks, "chunk"), (&self.damaged_records, "record")] {
+            if !skipped.is_empty() {
+                let at = if skipped.len() == 1 { "offset" } else { "offsets" };
+                out += &format!(", {} skipped at {at} {}", plural(skipped.len(), what), offsets(skipped));
+            }
+        }
+        if self.bad_data_crc {
+            out += ", but the data section's CRC does not match: a record without a CRC of its own \
+                    (metadata, an index) is damaged";
+        }
+        if let Some(e) = &self.stopped_at {
+            out += &format!(" (the rest was lost: {e})");
+        }
+        out
+    }
+}
+
+/// Copies what can be read and verified of `input` into a new, complete MCAP file at `output`,
+/// which may not be `input` itself.
 pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordingError> {
+    refuse_overwrite(input, output)?;
     let recording = Recording::open(input)?;
     let bytes = recording.bytes();
     if !bytes.starts_with(mcap::MAGIC) {
         return Err(RecordingError::NoMagic { file: input.to_owned() });
     }
-    let not_mcap = |cause| RecordingError::NotMcap { file: input.to_owned(), cause };
-    let options = EnumSet::only(Options::IgnoreEndMagic);
-    let mut profile = String::new();
-    let mut attachments = Vec::new();
-    let mut metadata = Vec::new();
-    let mut stopped_at = None;
-    let linear = mcap::read::LinearReader::new_with_options(bytes, options).map_err(not_mcap)?;
-    for record in linear {
-        match record {
-            Ok(Record::Header(h)) => profile = h.profile,
-            Ok(Record::Attachment { header, data, .. }) => attachments.push((header, data)),
-            Ok(Record::Metadata(m)) => metadata.push(m),
-            Ok(_) => {}
-            Err(e) => {
-                stopped_at = Some(e.to_string());
-                break;
-            }
-        }
-    }
+    let records = salvage::records(bytes);
     let out =
         File::create(output).map_err(|cause| RecordingError::Create { file: output.to_owned(), cause })?;
     let oerr = |cause| RecordingError::Write { file: output.to_owned(), cause };
     let mut w = mcap::WriteOptions::new()
-        .profile(&profile)
+        .profile(&records.profile)
         .library(concat!("harvey recover ", env!("CARGO_PKG_VERSION")))
         .create(BufWriter::new(out))
         .map_err(oerr)?;
-    for (h, data) in &attachments {
-        let a = mcap::Attachment {
-            log_time: h.log_time,
-            create_time: h.create_time,
-            name: h.name.clone(),
-            media_type: h.media_type.clone(),
-            data: Cow::Borrowed(data),
-        };
-        w.attach(&a).map_err(oerr)?;
+    for a in &records.attachments {
+        w.attach(a).map_err(oerr)?;
     }
-    for m in &metadata {
+    for m in &records.metadata {
         w.write_metadata(m).map_err(oerr)?;
     }
     let mut messages = 0;
-    let stream = mcap::MessageStream::new_with_options(bytes, options).map_err(not_mcap)?;
-    for m in stream {
-        match m {
-            Ok(m) => {
-                w.write(&m).map_err(oerr)?;
-                messages += 1;
-            }
-            Err(e) => {
-                stopped_at.get_or_insert(e.to_string());
-                break;
-            }
+    // Channels a damaged chunk defined are still known from the summary, when it reads.
+    let mut salvaged = salvage::Messages::new(bytes, recording.summary_if_any());
+    for chunk in salvaged.by_ref() {
+        for m in &chunk {
+            w.write(m).map_err(oerr)?;
+            messages += 1;
         }
     }
+    let mut damaged_records = records.damaged;
+    damaged_records.extend(&salvaged.damaged_records);
+    damaged_records.sort_unstable();
+    let s = Salvage {
+        messages,
+        attachments: records.attachments.len() as u64,
+        bad_data_crc: records.bad_data_crc
+            && salvaged.damaged_chunks.is_empty()
+            && damaged_records.is_empty(),
+        damaged_chunks: salvaged.damaged_chunks,
+        damaged_records,
+        stopped_at: records.stopped_at,
+    };
+    w.write_metadata(&metadata(input, &s)).map_err(oerr)?;
+    w.finish().map_err(oerr)?;
+    Ok(s)
+}
+
+/// The `harvey.recover` record: the source, messages salvaged, where it stopped, and (only when
+/// there were any) the offsets of what was skipped.
+fn metadata(input: &Path, s: &Salvage) -> Metadata {
     let mut md = std::collections::BTreeMap::new();
     md.insert("source".to_owned(), input.display().to_string());
-    md.insert("messages".to_owned(), messages.to_string());
-    md.insert("stopped_at".to_owned(), stopped_at.clone().unwrap_or_else(|| "end of file".into()));
-    w.write_metadata(&Metadata { name: RECOVER_METADATA.into(), metadata: md }).map_err(oerr)?;
-    w.finish().map_err(oerr)?;
-    Ok(Salvage { messages, attachments: attachments.len() as u64, stopped_at })
+    md.insert("messages".to_owned(), s.messages.to_string());
+    md.insert("stopped_at".to_owned(), s.stopped_at.clone().unwrap_or_else(|| "end of file".into()));
+    let offsets = |o: &[u64]| o.iter().map(u64::to_string).collect::<Vec<_>>().join(",");
+    if !s.damaged_chunks.is_empty() {
+        md.insert("damaged_chunks".to_owned(), offsets(&s.damaged_chunks));
+    }
+    if !s.damaged_records.is_empty() {
+        md.insert("damaged_records".to_owned(), offsets(&s.damaged_records));
+    }
+    if s.bad_data_crc {
+        md.insert("bad_data_crc".to_owned(), "true".to_owned());
+    }
+    Metadata { name: RECOVER_METADATA.into(), metadata: md }
 }
