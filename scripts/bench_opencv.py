@@ -1,5 +1,7 @@
 """Times OpenCV on the frames and windows `cargo bench -p harvey-vision --bench kernels` used,
-single thread, and writes the Harvey / OpenCV table into docs/benchmarks.md.
+single thread, and writes the Harvey / OpenCV table into docs/benchmarks.md: one table per
+instruction-set path the kernels bench ran (`HARVEY_SIMD`), each headed by the CPU model, its
+SIMD features and the path, between `<!-- vision-opencv:PATH:start -->` and `...:end -->`.
 
 OpenCV has no Moravec operator, no Burns line finder and no reflectance-normalised correlation;
 each row names the nearest OpenCV routine timed in its place: TM_CCORR_NORMED template matching,
@@ -18,7 +20,10 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 BENCH = ROOT / "target" / "vision-bench"
 DOC = ROOT / "docs" / "benchmarks.md"
-START, END = "<!-- vision-opencv:start -->", "<!-- vision-opencv:end -->"
+
+
+def markers(path):
+    return f"<!-- vision-opencv:{path}:start -->", f"<!-- vision-opencv:{path}:end -->"
 
 
 def timed(f, budget=0.3):
@@ -95,11 +100,17 @@ NO_COUNTERPART = ("stereo", "depth from motion", "constrained Hough", "path foll
 
 def main():
     cv2.setNumThreads(1)
-    rows = [l.split("\t") for l in (BENCH / "harvey.tsv").read_text().splitlines()[1:]]
+    text = (BENCH / "harvey.tsv").read_text().splitlines()
+    meta = dict(l[2:].split("\t", 1) for l in text if l.startswith("# "))
+    rows = [l.split("\t") for l in text if not l.startswith("# ")][1:]
+    path = meta.get("path", "unknown")
+    print(f"CPU: {meta.get('cpu', 'unknown')}")
+    print(f"SIMD features: {meta.get('features', 'unknown')}")
+    print(f"Harvey path: {path}")
     frames = {}
-    lines = ["| kernel | image | scope | Harvey µs | OpenCV µs | OpenCV routine | OpenCV / Harvey |",
-             "|---|---|---|---:|---:|---|---:|"]
-    for kernel, size, scope, win, tmpl, harvey_us, _ref in rows:
+    lines = ["| kernel | image | scope | path | Harvey µs | OpenCV µs | OpenCV routine | OpenCV / Harvey |",
+             "|---|---|---|---|---:|---:|---|---:|"]
+    for kernel, size, scope, win, tmpl, harvey_us, _ref, row_path in rows:
         img = frames.setdefault(size, cv2.imread(str(BENCH / f"frame_{size}.pgm"), cv2.IMREAD_GRAYSCALE))
         if img is None:
             sys.exit(f"cannot read {BENCH / f'frame_{size}.pgm'}: run the kernels bench first")
@@ -108,15 +119,17 @@ def main():
             continue
         name, f = case
         us = timed(f)
-        lines.append(f"| {kernel} | {size} | {scope} | {float(harvey_us):.1f} | {us:.1f} | {name} | "
+        lines.append(f"| {kernel} | {size} | {scope} | {row_path} | {float(harvey_us):.1f} | {us:.1f} | {name} | "
                      f"{us / float(harvey_us):.2f}x |")
     table = "\n".join(lines)
     print(table)
     text = DOC.read_text()
-    block = (f"{START}\nOpenCV {cv2.__version__}, `cv2.setNumThreads(1)`, same frames and windows "
-             f"(no rows for {', '.join(NO_COUNTERPART)}: no counterpart on one frame):\n\n{table}\n{END}")
-    if START in text and END in text:
-        text = text[: text.index(START)] + block + text[text.index(END) + len(END):]
+    start, end = markers(path)
+    block = (f"{start}\nCPU: {meta.get('cpu', 'unknown')}; SIMD features: {meta.get('features', 'unknown')}; "
+             f"Harvey path: {path}. OpenCV {cv2.__version__}, `cv2.setNumThreads(1)`, same frames and windows "
+             f"(no rows for {', '.join(NO_COUNTERPART)}: no counterpart on one frame):\n\n{table}\n{end}")
+    if start in text and end in text:
+        text = text[: text.index(start)] + block + text[text.index(end) + len(end):]
     else:
         text = text.rstrip("\n") + "\n\n" + block + "\n"
     DOC.write_text(text)

@@ -3,6 +3,9 @@
 //! on rendered hallway frames. Writes the frames (PGM) and the figures (TSV) to
 //! `target/vision-bench/` for `scripts/bench-opencv`, which times OpenCV on the same images.
 //!
+//! It prints the CPU model, its SIMD features and the instruction-set path each row ran
+//! (`HARVEY_SIMD=portable|avx2|avx512` lowers it, never past what the CPU has).
+//!
 //! `taskset -c 0 cargo bench -p harvey-vision --bench kernels`
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
@@ -24,6 +27,7 @@ use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::pyramid::{Pyramid, coarse_to_fine};
+use harvey_vision::simd::{self, Path as SimdPath};
 use harvey_vision::{Gray, GrayBuf, Rect};
 
 /// Median microseconds per call of `f`, over enough calls to fill about 0.3 s.
@@ -52,12 +56,44 @@ struct Row {
     template: Rect,
     harvey_us: f64,
     reference_us: f64,
+    /// The instruction-set path Harvey's kernel ran.
+    path: String,
 }
 
 impl Row {
     fn new(kernel: &'static str, size: &str, scope: String, window: Rect, template: Rect) -> Self {
-        Self { kernel, size: size.to_owned(), scope, window, template, harvey_us: 0.0, reference_us: 0.0 }
+        let path = path_of(kernel);
+        Self {
+            kernel,
+            size: size.to_owned(),
+            scope,
+            window,
+            template,
+            harvey_us: 0.0,
+            reference_us: 0.0,
+            path,
+        }
     }
+}
+
+/// The path a kernel runs: the dispatched one for correlation, Moravec and what is built on
+/// them; the rest have no hand-written SIMD and run the build's baseline code.
+fn path_of(kernel: &str) -> String {
+    let dispatched = ["normalised correlation", "Moravec", "coarse-to-fine", "stereo", "depth from motion"];
+    if dispatched.iter().any(|k| kernel.starts_with(k)) {
+        SimdPath::active().name().to_owned()
+    } else {
+        "baseline".to_owned()
+    }
+}
+
+/// The CPU's model name (from `/proc/cpuinfo`, where there is one).
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| t.lines().find(|l| l.starts_with("model name")).map(|l| l.to_owned()))
+        .and_then(|l| l.split_once(':').map(|(_, m)| m.trim().to_owned()))
+        .unwrap_or_else(|| "unknown".to_owned())
 }
 
 /// Times Harvey's kernel and the reference, in the same run.
@@ -216,7 +252,13 @@ fn bench_coarse_to_fine(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
     for (scope, win) in
         [("full frame".to_owned(), img.full()), ("96x96 window".to_owned(), around(img, tr, 96))]
     {
-        pi.build(img, 3).expect("pyramid");
+        // Over the whole frame for a full-frame search, over the window (widened to whole
+        // coarsest pixels) for a search in it.
+        let whole = win == img.full();
+        let build = |pi: &mut Pyramid| {
+            if whole { pi.build(img, 3) } else { pi.build_around(img, win, 3) }.expect("pyramid");
+        };
+        build(&mut pi);
         let m = coarse_to_fine(&pi, &pt, win, 2, &mut c).expect("found");
         assert_eq!((m.x, m.y), (tr.x0, tr.y0), "found where it was cut, {scope}");
         let kernel = "coarse-to-fine correlation 32x32 (vs exhaustive)";
@@ -224,7 +266,7 @@ fn bench_coarse_to_fine(img: &Gray<'_>, size: &str, rows: &mut Vec<Row>) {
         rows.push(measure(
             Row::new(kernel, size, scope, win, tr),
             || {
-                pi.build(img, 3).expect("pyramid");
+                build(&mut pi);
                 black_box(coarse_to_fine(&pi, &pt, win, 2, &mut c).expect("found"));
             },
             || {
@@ -276,6 +318,15 @@ fn main() {
     let world = harvey_world::World::load(&root.join("worlds/hallway.toml")).expect("world");
     let out = root.join("target/vision-bench");
     std::fs::create_dir_all(&out).expect("output folder");
+    let (model, features, path) = (cpu_model(), simd::cpu_features(), SimdPath::active());
+    println!("CPU: {model}");
+    println!("SIMD features: {features}");
+    println!(
+        "path: {path} (fastest here: {}; {}={:?})",
+        SimdPath::best(),
+        simd::ENV,
+        std::env::var(simd::ENV).ok()
+    );
     let mut rows = Vec::new();
     for (w, h) in [(640u32, 480u32), (256, 256)] {
         let img = frame(&world, w, h);
@@ -292,29 +343,32 @@ fn main() {
         geometry::bench_hough(&img, &size, &mut rows);
         geometry::bench_path(w as usize, h as usize, &size, &mut rows);
     }
-    println!("| kernel | image | scope | harvey µs | reference µs | reference / harvey |");
-    println!("|---|---|---|---:|---:|---:|");
-    let mut tsv = String::from("kernel\tsize\tscope\twindow\ttemplate\tharvey_us\treference_us\n");
+    println!("| kernel | image | scope | path | harvey µs | reference µs | reference / harvey |");
+    println!("|---|---|---|---|---:|---:|---:|");
+    let mut tsv = format!("# cpu\t{model}\n# features\t{features}\n# path\t{path}\n");
+    tsv += "kernel\tsize\tscope\twindow\ttemplate\tharvey_us\treference_us\tpath\n";
     for r in &rows {
         println!(
-            "| {} | {} | {} | {:.1} | {:.1} | {:.1}x |",
+            "| {} | {} | {} | {} | {:.1} | {:.1} | {:.1}x |",
             r.kernel,
             r.size,
             r.scope,
+            r.path,
             r.harvey_us,
             r.reference_us,
             r.reference_us / r.harvey_us
         );
         let rect = |r: Rect| format!("{},{},{},{}", r.x0, r.y0, r.x1, r.y1);
         tsv += &format!(
-            "{}\t{}\t{}\t{}\t{}\t{:.3}\t{:.3}\n",
+            "{}\t{}\t{}\t{}\t{}\t{:.3}\t{:.3}\t{}\n",
             r.kernel,
             r.size,
             r.scope,
             rect(r.window),
             rect(r.template),
             r.harvey_us,
-            r.reference_us
+            r.reference_us,
+            r.path
         );
     }
     std::fs::write(out.join("harvey.tsv"), tsv).expect("writes the figures");

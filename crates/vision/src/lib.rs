@@ -2,6 +2,7 @@
 //! or a state machine with reusable buffers, no IO, no clock. The vision-workers service runs them
 //! on camera frames in shared memory, inside the windows it is asked to look in.
 
+mod cross;
 pub mod cues;
 pub mod depth;
 pub mod flf;
@@ -13,7 +14,7 @@ pub mod nc;
 pub mod path;
 pub mod pyramid;
 pub mod regions;
-mod simd;
+pub mod simd;
 pub mod stereo;
 
 pub use image::{Gray, GrayBuf, Rect, VisionError};

@@ -5,10 +5,13 @@
 //! With `S_P = ΣP`, `S_T = ΣT` that is `NC = 2 ΣPT S_P S_T / (ΣP² S_T² + ΣT² S_P²)`: only ΣPT
 //! needs the template; `S_P` and `ΣP²` come from integral images. ΣPT is computed as
 //! `Σ P (T - 128) + 128 S_P`, so the template fits signed bytes and, where the CPU has AVX-512
-//! VNNI, sixty-four byte products go into one instruction (`cross_avx512`); elsewhere a portable
-//! loop does the same sums.
+//! VNNI, sixty-four byte products go into one instruction (`cross.rs`, with an AVX2 and a
+//! portable form of the same sums). The scoring pass is one body compiled for each
+//! [`Path`](crate::simd::Path).
 
+use crate::cross::{BLOCK_X, BLOCK_Y, Packed, cross};
 use crate::image::{Gray, GrayBuf, Rect, VisionError};
+use crate::simd::Path;
 
 /// Largest template side: keeps `Σ P (T - 128)` inside an `i32`.
 pub const MAX_TEMPLATE: usize = 128;
@@ -20,15 +23,13 @@ pub struct Template {
     pub height: usize,
     sum: f64,
     sum_sq: f64,
-    /// `T - 128` as signed bytes, rows padded to a multiple of 4 with zeros, packed 4 to an i32.
-    packed: Vec<i32>,
-    /// i32 groups per row.
-    groups: usize,
+    /// `T - 128` as signed bytes, packed for the cross-sum kernels.
+    packed: Packed,
 }
 
 impl Template {
     pub fn new(t: &GrayBuf) -> Result<Self, VisionError> {
-        let mut out = Self { width: 0, height: 0, sum: 0.0, sum_sq: 0.0, packed: Vec::new(), groups: 0 };
+        let mut out = Self { width: 0, height: 0, sum: 0.0, sum_sq: 0.0, packed: Packed::default() };
         out.set(t)?;
         Ok(out)
     }
@@ -48,17 +49,9 @@ impl Template {
         if sum == 0.0 {
             return Err(VisionError::BadParameter("an all-black template has no reflectance pattern".into()));
         }
-        let groups = w.div_ceil(4);
-        self.packed.clear();
-        self.packed.resize(groups * h, 0);
-        for y in 0..h {
-            for x in 0..w {
-                let v = (i32::from(t.data[y * w + x]) - 128) as i8 as u8;
-                self.packed[y * groups + x / 4] |= i32::from(v) << (8 * (x % 4));
-            }
-        }
+        self.packed.set(&t.data, w, h);
         self.sum_sq = t.data.iter().map(|&v| f64::from(v) * f64::from(v)).sum();
-        (self.width, self.height, self.sum, self.groups) = (w, h, sum, groups);
+        (self.width, self.height, self.sum) = (w, h, sum);
         Ok(())
     }
 }
@@ -90,12 +83,22 @@ pub struct Correlator {
     scores: Vec<f32>,
     nx: usize,
     ny: usize,
+    /// The instruction-set path, if not [`Path::active`] (tests and benchmarks set it).
+    path: Option<Path>,
 }
 
-const BLOCK_X: usize = 16;
-const BLOCK_Y: usize = 4;
-
 impl Correlator {
+    /// Runs on `path` from now on (lowered to the fastest the CPU has): every path gives the
+    /// same scores, bit for bit.
+    pub fn set_path(&mut self, path: Path) {
+        self.path = Some(Path::clamp(path));
+    }
+
+    /// The instruction-set path this correlator runs.
+    pub fn path(&self) -> Path {
+        self.path.unwrap_or_else(Path::active)
+    }
+
     /// Scores every placement of `t` whose pixels all lie in `window`: row-major, `nx x ny`
     /// (see [`Correlator::placements`]), the top-left placement first.
     pub fn correlate(&mut self, img: &Gray<'_>, window: Rect, t: &Template) -> Result<&[f32], VisionError> {
@@ -108,8 +111,17 @@ impl Correlator {
         self.copy_padded(img, w, t);
         self.cross.clear();
         self.cross.resize(nx.next_multiple_of(BLOCK_X) * ny.next_multiple_of(BLOCK_Y), 0);
-        cross(&self.pad, self.pad_width, nx, ny, t, &mut self.cross);
-        self.score(w, t);
+        let path = self.path();
+        cross(path, &self.pad, self.pad_width, nx, ny, &t.packed, &mut self.cross);
+        match path {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `path()` is one the CPU has.
+            Path::Avx512 => unsafe { score_avx512(self, w, t) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above.
+            Path::Avx2 => unsafe { score_avx2(self, w, t) },
+            _ => score(self, w, t),
+        }
         Ok(&self.scores)
     }
 
@@ -120,6 +132,18 @@ impl Correlator {
 
     /// The best placement of `t` in `window`.
     pub fn best(&mut self, img: &Gray<'_>, window: Rect, t: &Template) -> Result<Match, VisionError> {
+        self.best_at(img, window, t, (0, 0))
+    }
+
+    /// [`Correlator::best`] in an image whose pixel `(0, 0)` is pixel `origin` of the frame the
+    /// match is reported in (a crop of it).
+    pub(crate) fn best_at(
+        &mut self,
+        img: &Gray<'_>,
+        window: Rect,
+        t: &Template,
+        origin: (usize, usize),
+    ) -> Result<Match, VisionError> {
         self.correlate(img, window, t)?;
         let (nx, ny) = (self.nx, self.ny);
         let (i, score) = self
@@ -136,7 +160,7 @@ impl Correlator {
         };
         let dx = if px > 0 && px + 1 < nx { vertex(at(px - 1, py), score, at(px + 1, py)) } else { 0.0 };
         let dy = if py > 0 && py + 1 < ny { vertex(at(px, py - 1), score, at(px, py + 1)) } else { 0.0 };
-        let (x, y) = (window.x0 + px, window.y0 + py);
+        let (x, y) = (origin.0 + window.x0 + px, origin.1 + window.y0 + py);
         let centre = [x as f32 + t.width as f32 / 2.0 + dx, y as f32 + t.height as f32 / 2.0 + dy];
         Ok(Match { x, y, centre, score })
     }
@@ -145,7 +169,7 @@ impl Correlator {
     /// last placement.
     fn copy_padded(&mut self, img: &Gray<'_>, w: Rect, t: &Template) {
         let (nx, ny) = (self.nx, self.ny);
-        self.pad_width = nx.next_multiple_of(BLOCK_X) + 4 * t.groups + 32;
+        self.pad_width = nx.next_multiple_of(BLOCK_X) + 4 * t.packed.groups + 32;
         let rows = ny.next_multiple_of(BLOCK_Y) + t.height + BLOCK_Y;
         self.pad.clear();
         self.pad.resize(self.pad_width * rows, 0);
@@ -154,54 +178,58 @@ impl Correlator {
                 .copy_from_slice(&img.row(y)[w.x0..w.x1]);
         }
     }
+}
 
-    /// Scores row by row: column sums over the template's height slide down a row at a time,
-    /// running sums along the row give each placement's `S_P` and `ΣP²` as a difference.
-    fn score(&mut self, w: Rect, t: &Template) {
-        let (nx, ny, ww, pw) = (self.nx, self.ny, w.width(), self.pad_width);
-        let cross_stride = nx.next_multiple_of(BLOCK_X);
-        self.scores.clear();
-        self.scores.resize(nx * ny, 0.0);
-        for v in [&mut self.col_sums, &mut self.col_squares] {
-            v.clear();
-            v.resize(ww, 0);
+/// Scores row by row: column sums over the template's height slide down a row at a time,
+/// running sums along the row give each placement's `S_P` and `ΣP²` as a difference.
+#[inline(always)]
+fn score(c: &mut Correlator, w: Rect, t: &Template) {
+    let (nx, ny, ww, pw) = (c.nx, c.ny, w.width(), c.pad_width);
+    let cross_stride = nx.next_multiple_of(BLOCK_X);
+    c.scores.clear();
+    c.scores.resize(nx * ny, 0.0);
+    for v in [&mut c.col_sums, &mut c.col_squares] {
+        v.clear();
+        v.resize(ww, 0);
+    }
+    for v in [&mut c.run_sums, &mut c.run_squares] {
+        v.clear();
+        v.resize(ww + 1, 0);
+    }
+    for r in 0..t.height {
+        add_row(&mut c.col_sums, &mut c.col_squares, &c.pad[r * pw..r * pw + ww]);
+    }
+    for y in 0..ny {
+        if y > 0 {
+            let (old, new) = ((y - 1) * pw, (y - 1 + t.height) * pw);
+            slide_row(&mut c.col_sums, &mut c.col_squares, &c.pad[old..old + ww], &c.pad[new..new + ww]);
         }
-        for v in [&mut self.run_sums, &mut self.run_squares] {
-            v.clear();
-            v.resize(ww + 1, 0);
-        }
-        for r in 0..t.height {
-            add_row(&mut self.col_sums, &mut self.col_squares, &self.pad[r * pw..r * pw + ww]);
-        }
-        for y in 0..ny {
-            if y > 0 {
-                let (old, new) = ((y - 1) * pw, (y - 1 + t.height) * pw);
-                slide_row(
-                    &mut self.col_sums,
-                    &mut self.col_squares,
-                    &self.pad[old..old + ww],
-                    &self.pad[new..new + ww],
-                );
-            }
-            running(&self.col_sums, &mut self.run_sums[1..]);
-            running(&self.col_squares, &mut self.run_squares[1..]);
-            let sums = RowSums {
-                run: &self.run_sums,
-                squares: &self.run_squares,
-                cross: &self.cross[y * cross_stride..],
-            };
-            let out = &mut self.scores[y * nx..(y + 1) * nx];
-            #[cfg(target_arch = "x86_64")]
-            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-                // SAFETY: the features are present.
-                unsafe { score_row_avx2(sums, t, out) };
-                continue;
-            }
-            score_row(sums, t, out);
-        }
+        running(&c.col_sums, &mut c.run_sums[1..]);
+        running(&c.col_squares, &mut c.run_squares[1..]);
+        let sums = RowSums { run: &c.run_sums, squares: &c.run_squares, cross: &c.cross[y * cross_stride..] };
+        score_row(sums, t, &mut c.scores[y * nx..(y + 1) * nx]);
     }
 }
 
+/// [`score`] compiled for AVX-512.
+///
+/// # Safety
+/// The CPU must have the features of [`Path::Avx512`].
+#[multiversion::target("x86_64+avx2+fma+bmi2+avx512f+avx512bw+avx512vnni")]
+unsafe fn score_avx512(c: &mut Correlator, w: Rect, t: &Template) {
+    score(c, w, t)
+}
+
+/// [`score`] compiled for AVX2 and FMA (which it does not fuse: the sums are the portable ones).
+///
+/// # Safety
+/// The CPU must have the features of [`Path::Avx2`].
+#[multiversion::target("x86_64+avx2+fma+bmi2")]
+unsafe fn score_avx2(c: &mut Correlator, w: Rect, t: &Template) {
+    score(c, w, t)
+}
+
+#[inline(always)]
 fn add_row(sums: &mut [u32], squares: &mut [u32], row: &[u8]) {
     for ((s, q), &p) in sums.iter_mut().zip(squares.iter_mut()).zip(row) {
         *s += u32::from(p);
@@ -209,6 +237,7 @@ fn add_row(sums: &mut [u32], squares: &mut [u32], row: &[u8]) {
     }
 }
 
+#[inline(always)]
 fn slide_row(sums: &mut [u32], squares: &mut [u32], old: &[u8], new: &[u8]) {
     for (((s, q), &o), &n) in sums.iter_mut().zip(squares.iter_mut()).zip(old).zip(new) {
         *s = s.wrapping_add(u32::from(n)).wrapping_sub(u32::from(o));
@@ -224,19 +253,13 @@ struct RowSums<'a> {
 }
 
 /// Running (wrapping) sums of `v` into `out`.
+#[inline(always)]
 fn running(v: &[u32], out: &mut [u32]) {
     let mut acc = 0u32;
     for (o, &x) in out.iter_mut().zip(v) {
         acc = acc.wrapping_add(x);
         *o = acc;
     }
-}
-
-/// [`score_row`] compiled for AVX2 and FMA.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn score_row_avx2(r: RowSums<'_>, t: &Template, out: &mut [f32]) {
-    score_row(r, t, out)
 }
 
 /// NC for one row of placements. Window sums stay below 2^31 (at most 128 x 128 x 255²), so
@@ -259,44 +282,6 @@ fn score_row(r: RowSums<'_>, t: &Template, out: &mut [f32]) {
     }
 }
 
-/// `Σ P (T - 128)` for every placement, into `out` (row stride `nx` rounded up to a block).
-fn cross(pad: &[u8], pw: usize, nx: usize, ny: usize, t: &Template, out: &mut [i32]) {
-    #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx512f")
-        && std::is_x86_feature_detected!("avx512bw")
-        && std::is_x86_feature_detected!("avx512vnni")
-    {
-        // SAFETY: the features are present, and `copy_padded` sized `pad` for whole blocks.
-        unsafe { crate::simd::cross_avx512(pad, pw, nx, ny, &t.packed, t.groups, t.height, out) };
-        return;
-    }
-    cross_portable(pad, pw, nx, ny, t, out);
-}
-
-/// The portable form of [`cross`]: one pass per template byte over a row of placements.
-pub(crate) fn cross_portable(pad: &[u8], pw: usize, nx: usize, ny: usize, t: &Template, out: &mut [i32]) {
-    let stride = nx.next_multiple_of(BLOCK_X);
-    for y in 0..ny {
-        let acc = &mut out[y * stride..y * stride + nx];
-        for r in 0..t.height {
-            let row = &pad[(y + r) * pw..];
-            for g in 0..t.groups {
-                let word = t.packed[r * t.groups + g];
-                for b in 0..4 {
-                    let tv = i32::from((word >> (8 * b)) as i8);
-                    if tv == 0 {
-                        continue;
-                    }
-                    let src = &row[4 * g + b..4 * g + b + nx];
-                    for (a, &p) in acc.iter_mut().zip(src) {
-                        *a += tv * i32::from(p);
-                    }
-                }
-            }
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,6 +292,10 @@ mod tests {
             let n = (x.wrapping_mul(7919) ^ y.wrapping_mul(104_729)).wrapping_mul(2_654_435_761) >> 7;
             (40 + (x + y) / 8 % 60 + n % 120) as u8
         })
+    }
+
+    fn bits(v: &[f32]) -> Vec<u32> {
+        v.iter().map(|x| x.to_bits()).collect()
     }
 
     /// The formula itself, in f64, placement by placement.
@@ -347,13 +336,17 @@ mod tests {
             for (g, w) in got.iter().zip(&want) {
                 assert!((f64::from(*g) - w).abs() < 1e-4, "{tw}x{th}: {g} vs {w}");
             }
-            // The portable sums equal the ones the CPU-specific path produced.
-            let mut portable = vec![0; c.cross.len()];
-            let (nx, ny) = c.placements();
-            cross_portable(&c.pad, c.pad_width, nx, ny, &tmpl, &mut portable);
-            let stride = nx.next_multiple_of(BLOCK_X);
-            for y in 0..ny {
-                assert_eq!(&portable[y * stride..y * stride + nx], &c.cross[y * stride..y * stride + nx]);
+            // Every path the CPU has gives the same cross sums and scores, bit for bit.
+            for path in Path::available() {
+                let mut other = Correlator::default();
+                other.set_path(path);
+                let scores = other.correlate(&img.view(), win, &tmpl).expect("correlates");
+                assert_eq!(bits(scores), bits(&got), "{path}, {tw}x{th}");
+                let (nx, ny) = c.placements();
+                let stride = nx.next_multiple_of(BLOCK_X);
+                for y in 0..ny {
+                    assert_eq!(&other.cross[y * stride..][..nx], &c.cross[y * stride..][..nx], "{path}");
+                }
             }
         }
     }

@@ -1,59 +1,137 @@
-//! AVX-512 VNNI kernels, chosen at run time where the CPU has them; each has a portable twin
-//! that tests compare it with.
+//! Which instruction-set path the kernels run: chosen once per process from what the CPU has,
+//! optionally lowered (never raised) by `HARVEY_SIMD=portable|avx2|avx512` for measurement.
+//!
+//! Every hot kernel has one portable body the compiler can vectorise, compiled again for each
+//! path with [`multiversion::target`], plus hand-written intrinsics where the compiler cannot
+//! find the instructions by itself (the correlation cross-sum, Moravec's peak row pass). Each
+//! kernel matches on a [`Path`]; tests run every [`Path::available`] one and compare bit for bit.
 
-#[cfg(target_arch = "x86_64")]
-use core::arch::x86_64::*;
+use std::fmt;
+use std::sync::OnceLock;
 
-/// `Σ P (T - 128)` for blocks of 16 placements x 4 rows at once. Each image row's bytes are
-/// gathered once per 4-column template group into "sliding dwords" (lane `j` holds bytes
-/// `x + j .. x + j + 4`) and multiplied by the template's group with `vpdpbusd`, for every output
-/// row that template row reaches.
-///
-/// # Safety
-/// The CPU must have AVX-512 F, BW and VNNI. `pad` must hold `ny` rounded up to 4, plus `rows`
-/// plus 4, rows of `pw` bytes, with `pw >= nx` rounded up to 16 plus `4 * groups + 32`; `out`
-/// must hold `ny` rounded up to 4 rows of `nx` rounded up to 16.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512bw,avx512vnni")]
-#[allow(clippy::too_many_arguments)]
-pub(crate) unsafe fn cross_avx512(
-    pad: &[u8],
-    pw: usize,
-    nx: usize,
-    ny: usize,
-    packed: &[i32],
-    groups: usize,
-    rows: usize,
-    out: &mut [i32],
-) {
-    let stride = nx.next_multiple_of(16);
-    let perm = _mm512_setr_epi32(0, 1, 2, 3, 1, 2, 3, 4, 2, 3, 4, 5, 3, 4, 5, 6);
-    let shuf = _mm512_broadcast_i32x4(_mm_setr_epi8(0, 1, 2, 3, 1, 2, 3, 4, 2, 3, 4, 5, 3, 4, 5, 6));
-    debug_assert!(pad.len() >= (ny.next_multiple_of(4) + rows + 4) * pw);
-    debug_assert!(out.len() >= ny.next_multiple_of(4) * stride);
-    for y0 in (0..ny).step_by(4) {
-        for xb in (0..nx).step_by(16) {
-            let mut acc = [_mm512_setzero_si512(); 4];
-            for yy in 0..rows + 3 {
-                // SAFETY: within `pad` by the size contract (row y0 + yy, bytes xb .. xb + 4 groups + 32).
-                let base = unsafe { pad.as_ptr().add((y0 + yy) * pw + xb) };
-                for g in 0..groups {
-                    // SAFETY: as above.
-                    let v = unsafe { _mm256_loadu_si256(base.add(4 * g) as *const __m256i) };
-                    let s =
-                        _mm512_shuffle_epi8(_mm512_permutexvar_epi32(perm, _mm512_castsi256_si512(v)), shuf);
-                    for (j, a) in acc.iter_mut().enumerate() {
-                        let Some(r) = yy.checked_sub(j).filter(|r| *r < rows) else { continue };
-                        *a = _mm512_dpbusd_epi32(*a, s, _mm512_set1_epi32(packed[r * groups + g]));
-                    }
-                }
-            }
-            for (j, a) in acc.iter().enumerate() {
-                // SAFETY: within `out` by the size contract.
-                unsafe {
-                    _mm512_storeu_si512(out.as_mut_ptr().add((y0 + j) * stride + xb) as *mut __m512i, *a)
-                };
-            }
+/// The environment variable that lowers the path for measurement.
+pub const ENV: &str = "HARVEY_SIMD";
+
+/// An instruction-set path, slowest first.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Path {
+    /// Plain Rust for the build's baseline target.
+    Portable,
+    /// x86-64-v3: AVX2, FMA, BMI2.
+    Avx2,
+    /// AVX-512 F, BW and VNNI (on top of AVX2).
+    Avx512,
+}
+
+impl Path {
+    /// Every path, slowest first.
+    pub const ALL: [Path; 3] = [Path::Portable, Path::Avx2, Path::Avx512];
+
+    /// The name `HARVEY_SIMD` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Path::Portable => "portable",
+            Path::Avx2 => "avx2",
+            Path::Avx512 => "avx512",
         }
+    }
+
+    /// The path named `s` (as `HARVEY_SIMD` spells it).
+    pub fn parse(s: &str) -> Option<Path> {
+        Path::ALL.into_iter().find(|p| p.name() == s.trim().to_ascii_lowercase())
+    }
+
+    /// Whether this CPU can run the path.
+    pub fn supported(self) -> bool {
+        match self {
+            Path::Portable => true,
+            #[cfg(target_arch = "x86_64")]
+            Path::Avx2 => {
+                std::is_x86_feature_detected!("avx2")
+                    && std::is_x86_feature_detected!("fma")
+                    && std::is_x86_feature_detected!("bmi2")
+            }
+            #[cfg(target_arch = "x86_64")]
+            Path::Avx512 => {
+                Path::Avx2.supported()
+                    && std::is_x86_feature_detected!("avx512f")
+                    && std::is_x86_feature_detected!("avx512bw")
+                    && std::is_x86_feature_detected!("avx512vnni")
+            }
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => false,
+        }
+    }
+
+    /// The fastest path this CPU has.
+    pub fn best() -> Path {
+        Path::ALL.into_iter().rev().find(|p| p.supported()).unwrap_or(Path::Portable)
+    }
+
+    /// Every path this CPU can run, slowest first (what the tests compare).
+    pub fn available() -> Vec<Path> {
+        Path::ALL.into_iter().filter(|p| p.supported()).collect()
+    }
+
+    /// The path the kernels use: the fastest the CPU has, or `HARVEY_SIMD` if that names a
+    /// slower one (a faster one than the CPU has, or an unknown name, is ignored). Read once.
+    pub fn active() -> Path {
+        static ACTIVE: OnceLock<Path> = OnceLock::new();
+        *ACTIVE.get_or_init(|| {
+            let wanted = std::env::var(ENV).ok().and_then(|v| Path::parse(&v));
+            Path::clamp(wanted.unwrap_or(Path::Avx512))
+        })
+    }
+
+    /// `wanted`, or the fastest path the CPU has if that is slower.
+    pub fn clamp(wanted: Path) -> Path {
+        wanted.min(Path::best())
+    }
+}
+
+impl fmt::Display for Path {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// The SIMD features of this CPU that the paths care about, space-separated (for benchmarks).
+pub fn cpu_features() -> String {
+    let mut out: Vec<&str> = Vec::new();
+    #[cfg(target_arch = "x86_64")]
+    {
+        macro_rules! probe {
+            ($($f:tt),*) => {$(
+                if std::is_x86_feature_detected!($f) {
+                    out.push($f);
+                }
+            )*};
+        }
+        probe!("sse4.2", "avx", "avx2", "fma", "bmi2", "avx512f", "avx512bw", "avx512vl", "avx512vnni");
+    }
+    #[cfg(target_arch = "aarch64")]
+    {
+        if std::arch::is_aarch64_feature_detected!("neon") {
+            out.push("neon");
+        }
+    }
+    out.join(" ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_round_trip_and_the_active_path_is_one_the_cpu_has() {
+        for p in Path::ALL {
+            assert_eq!(Path::parse(p.name()), Some(p));
+        }
+        assert_eq!(Path::parse("AVX2"), Some(Path::Avx2));
+        assert_eq!(Path::parse("neon"), None);
+        assert!(Path::active().supported());
+        assert!(Path::clamp(Path::Avx512).supported());
+        assert_eq!(Path::clamp(Path::Portable), Path::Portable);
+        assert_eq!(Path::available().first(), Some(&Path::Portable));
     }
 }

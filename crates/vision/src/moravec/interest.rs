@@ -5,6 +5,7 @@
 //! pass runs in the first-level cache.
 
 use crate::image::{Gray, Rect};
+use crate::simd::Path;
 
 /// The four shifts: right, down, and the two diagonals.
 pub(super) const SHIFTS: [(isize, isize); 4] = [(1, 0), (0, 1), (1, 1), (1, -1)];
@@ -28,29 +29,41 @@ fn margin(k: usize) -> usize {
     k / 2 + 1
 }
 
-/// Streams every row of `w` (0 in the margins) to `sink`, top to bottom.
-pub(super) fn interest_rows(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
-    #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("avx512bw") {
-        // SAFETY: the CPU has AVX-512 F and BW.
-        return unsafe { rows_avx512(img, w, k, cols, sink) };
+/// Streams every row of `w` (0 in the margins) to `sink`, top to bottom, on `path` (one the
+/// CPU has). The body is portable code the compiler vectorises, compiled once per path.
+pub(super) fn interest_rows(
+    path: Path,
+    img: &Gray<'_>,
+    w: Rect,
+    k: usize,
+    cols: &mut Columns,
+    sink: &mut impl RowSink,
+) {
+    match Path::clamp(path) {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: the CPU has the path's features (clamped).
+        Path::Avx512 => unsafe { rows_avx512(img, w, k, cols, sink) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: as above.
+        Path::Avx2 => unsafe { rows_avx2(img, w, k, cols, sink) },
+        _ => rows(img, w, k, cols, sink),
     }
-    #[cfg(target_arch = "x86_64")]
-    if std::is_x86_feature_detected!("avx2") {
-        // SAFETY: the CPU has AVX2.
-        return unsafe { rows_avx2(img, w, k, cols, sink) };
-    }
-    rows(img, w, k, cols, sink)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512bw")]
+/// [`rows`] compiled for AVX-512.
+///
+/// # Safety
+/// The CPU must have the features of [`Path::Avx512`].
+#[multiversion::target("x86_64+avx2+fma+bmi2+avx512f+avx512bw+avx512vnni")]
 unsafe fn rows_avx512(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
     rows(img, w, k, cols, sink)
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
+/// [`rows`] compiled for AVX2.
+///
+/// # Safety
+/// The CPU must have the features of [`Path::Avx2`].
+#[multiversion::target("x86_64+avx2+fma+bmi2")]
 unsafe fn rows_avx2(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
     rows(img, w, k, cols, sink)
 }

@@ -8,10 +8,10 @@
 
 mod interest;
 mod peaks;
-#[cfg(target_arch = "x86_64")]
 mod peaks_simd;
 
 use crate::image::{Gray, Rect, VisionError};
+use crate::simd::Path;
 use interest::{Columns, RowSink, interest_rows};
 use peaks::{PeakSink, Peaks};
 
@@ -49,9 +49,22 @@ pub struct Moravec {
     peaks: Peaks,
     corners: Vec<Corner>,
     map: Vec<u32>,
+    /// The instruction-set path, if not [`Path::active`] (tests and benchmarks set it).
+    path: Option<Path>,
 }
 
 impl Moravec {
+    /// Runs on `path` from now on (lowered to the fastest the CPU has): every path finds the
+    /// same corners and interest, bit for bit.
+    pub fn set_path(&mut self, path: Path) {
+        self.path = Some(Path::clamp(path));
+    }
+
+    /// The instruction-set path this operator runs.
+    pub fn path(&self) -> Path {
+        self.path.unwrap_or_else(Path::active)
+    }
+
     /// The corners in `window`, strongest first (ties: top to bottom, left to right).
     pub fn corners(
         &mut self,
@@ -61,9 +74,10 @@ impl Moravec {
     ) -> Result<&[Corner], VisionError> {
         let w = checked(img, window, p)?;
         self.corners.clear();
-        self.peaks.start(w.width(), w.height(), (w.x0, w.y0), p.suppress_radius, p.threshold);
+        let path = self.path();
+        self.peaks.start(w.width(), w.height(), (w.x0, w.y0), p.suppress_radius, p.threshold, path);
         let mut sink = PeakSink { peaks: &mut self.peaks, corners: &mut self.corners };
-        interest_rows(img, w, p.window, &mut self.cols, &mut sink);
+        interest_rows(path, img, w, p.window, &mut self.cols, &mut sink);
         self.peaks.finish(&mut self.corners);
         let order = |a: &Corner, b: &Corner| b.interest.cmp(&a.interest).then((a.y, a.x).cmp(&(b.y, b.x)));
         if self.corners.len() > p.max_corners && p.max_corners > 0 {
@@ -89,8 +103,9 @@ impl Moravec {
     ) -> Result<&[u32], VisionError> {
         let w = checked(img, window, p)?;
         self.map.resize(w.width() * w.height(), 0);
+        let path = self.path();
         let mut sink = MapSink { map: &mut self.map, width: w.width() };
-        interest_rows(img, w, p.window, &mut self.cols, &mut sink);
+        interest_rows(path, img, w, p.window, &mut self.cols, &mut sink);
         Ok(&self.map)
     }
 }
@@ -247,8 +262,14 @@ mod tests {
         // Texture, and a coarse checkerboard whose repeats give plateaus of equal interest.
         let texture = GrayBuf::from_fn(83, 61, |x, y| ((x * 37 + y * 91 + x * y * 13) % 251) as u8);
         let boards = GrayBuf::from_fn(83, 61, |x, y| if (x / 10 + y / 10) % 2 == 0 { 200 } else { 30 });
-        let mut portable = Moravec::default();
-        portable.peaks.portable = true;
+        let mut paths: Vec<(Path, Moravec)> = Path::available()
+            .into_iter()
+            .map(|path| {
+                let mut m = Moravec::default();
+                m.set_path(path);
+                (path, m)
+            })
+            .collect();
         for (name, img) in [("texture", &texture), ("checkerboard", &boards)] {
             let v = img.view();
             for win in [v.full(), Rect::new(7, 5, 70, 50), Rect::new(3, 2, 30, 14)] {
@@ -262,7 +283,8 @@ mod tests {
                     let mut m = Moravec::default();
                     let map = m.interest_map(&v, win, &p).expect("runs").to_vec();
                     let want = brute_corners(&map, win.width(), win.height(), win, r, p.threshold);
-                    for (path, op) in [("dispatched", &mut m), ("portable", &mut portable)] {
+                    for (path, op) in &mut paths {
+                        assert_eq!(op.interest_map(&v, win, &p).expect("runs"), &map[..], "{path}");
                         let mut got: Vec<(usize, usize)> =
                             op.corners(&v, win, &p).expect("runs").iter().map(|c| (c.x, c.y)).collect();
                         got.sort_by_key(|&(x, y)| (y, x));

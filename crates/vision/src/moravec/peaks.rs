@@ -5,10 +5,11 @@
 //! the rows above and below agree at its column, so no whole-frame map is written or read.
 //!
 //! Interest rows sit in the ring with `r` zeros either side, so the row maxima need no edge
-//! cases. The row pass uses AVX-512 where the CPU has it (`peaks_simd.rs`), with a portable twin.
+//! cases. The row pass has AVX-512 and AVX2 forms (`peaks_simd.rs`) and a portable twin.
 
 use super::Corner;
 use super::interest::RowSink;
+use crate::simd::Path;
 
 /// Ring buffers of the last `2r + 1` interest rows (padded), their row-window maxima, and the
 /// pixels at or above the threshold that top their row window.
@@ -26,8 +27,8 @@ pub(super) struct Peaks {
     threshold: u32,
     /// Where the window starts in the image (corners are reported in image coordinates).
     origin: (usize, usize),
-    /// Use the portable code even where AVX-512 is there (to test one against the other).
-    pub(super) portable: bool,
+    /// The instruction-set path of the row pass.
+    path: Option<Path>,
 }
 
 impl Peaks {
@@ -39,7 +40,9 @@ impl Peaks {
         origin: (usize, usize),
         r: usize,
         threshold: u32,
+        path: Path,
     ) {
+        self.path = Some(path);
         let slots = 2 * r + 1;
         (self.width, self.height, self.r, self.threshold, self.origin) =
             (width, height, r, threshold.max(1), origin);
@@ -66,12 +69,7 @@ impl Peaks {
         let across = &mut self.across[s * ww..(s + 1) * ww];
         let tops = &mut self.tops[s];
         tops.clear();
-        #[cfg(target_arch = "x86_64")]
-        if !self.portable && super::peaks_simd::available() {
-            // SAFETY: the CPU has AVX-512 F.
-            return unsafe { super::peaks_simd::scan(row, r, t, across, tops) };
-        }
-        scan_portable(row, r, t, across, tops);
+        super::peaks_simd::scan(self.path.unwrap_or_else(Path::active), row, r, t, across, tops);
     }
 
     /// Appends the corners of row `y` (all of rows `y - r ..= y + r` that exist are in the ring).
@@ -112,7 +110,7 @@ impl Peaks {
 
 /// The portable twin of `peaks_simd::scan`: `across[x]` = the maxima of padded row `row` over
 /// `x ..= x + 2r`, and every `x` at or above `threshold` that equals it appended to `tops`.
-fn scan_portable(row: &[u32], r: usize, threshold: u32, across: &mut [u32], tops: &mut Vec<u32>) {
+pub(super) fn scan_portable(row: &[u32], r: usize, threshold: u32, across: &mut [u32], tops: &mut Vec<u32>) {
     let ww = across.len();
     across.copy_from_slice(&row[..ww]);
     for t in 1..=2 * r {

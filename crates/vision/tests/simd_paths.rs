@@ -1,0 +1,140 @@
+//! Every instruction-set path this CPU has (`harvey_vision::simd::Path::available`) gives the
+//! same results, bit for bit, as the portable one: correlation scores and matches, Moravec
+//! interest maps and corners, and coarse-to-fine matches, on random images of odd widths (1, 15,
+//! 17, 641 px: no path may read past a row end or lose the last pixels) and on rendered frames.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
+
+use harvey_msgs::Encoding;
+use harvey_render::Renderer;
+use harvey_vision::moravec::{Moravec, MoravecParams};
+use harvey_vision::nc::{Correlator, Template};
+use harvey_vision::pyramid::{Pyramid, coarse_to_fine};
+use harvey_vision::simd::Path;
+use harvey_vision::{Gray, GrayBuf, Rect};
+use harvey_world::{Pose2, World};
+
+/// A hashed image: every byte value, no structure.
+fn random(w: usize, h: usize, seed: u64) -> GrayBuf {
+    GrayBuf::from_fn(w, h, |x, y| {
+        let mut z = seed ^ ((y * w + x) as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        (z >> 56) as u8
+    })
+}
+
+fn rendered(w: u32, h: u32, pose: Pose2) -> GrayBuf {
+    let world: World =
+        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads");
+    let mut r = Renderer::new(&world, w, h, Encoding::Mono8);
+    let mut px = vec![0u8; r.frame_bytes()];
+    r.render(&world, pose, &mut px).expect("renders");
+    GrayBuf { width: w as usize, height: h as usize, data: px }
+}
+
+fn bits(v: &[f32]) -> Vec<u32> {
+    v.iter().map(|x| x.to_bits()).collect()
+}
+
+/// Scores of `t` (cut from `img` at `at`) in `win`, on each path, all equal to the portable ones.
+fn correlation_agrees(img: &Gray<'_>, win: Rect, at: Rect) {
+    // A template that happens to be all black is refused on every path alike.
+    let Ok(t) = Template::new(&GrayBuf::crop(img, at).expect("crop")) else { return };
+    let mut want = Correlator::default();
+    want.set_path(Path::Portable);
+    let scores = bits(want.correlate(img, win, &t).expect("correlates"));
+    let best = want.best(img, win, &t).expect("best");
+    for path in Path::available() {
+        let mut c = Correlator::default();
+        c.set_path(path);
+        assert_eq!(c.path(), path);
+        assert_eq!(bits(c.correlate(img, win, &t).expect("correlates")), scores, "{path}: {win}, {at}");
+        let got = c.best(img, win, &t).expect("best");
+        assert_eq!(format!("{got:?}"), format!("{best:?}"), "{path}: {win}, {at}");
+    }
+}
+
+/// Interest map and corners in `win` on each path, all equal to the portable ones.
+fn moravec_agrees(img: &Gray<'_>, win: Rect) {
+    for (window, r) in [(3, 1), (5, 3), (7, 2), (9, 5)] {
+        let p = MoravecParams { window, threshold: 1, suppress_radius: r, max_corners: 100_000 };
+        let mut want = Moravec::default();
+        want.set_path(Path::Portable);
+        let map = want.interest_map(img, win, &p).expect("runs").to_vec();
+        let corners = want.corners(img, win, &p).expect("runs").to_vec();
+        for path in Path::available() {
+            let mut m = Moravec::default();
+            m.set_path(path);
+            assert_eq!(m.interest_map(img, win, &p).expect("runs"), &map[..], "{path}: {win}, k {window}");
+            assert_eq!(m.corners(img, win, &p).expect("runs"), &corners[..], "{path}: {win}, k {window}");
+        }
+    }
+}
+
+#[test]
+fn random_images_of_odd_widths_agree_on_every_path() {
+    for (w, h) in [(1, 9), (15, 13), (17, 21), (641, 23), (33, 40)] {
+        let img = random(w, h, (w * 1000 + h) as u64);
+        let v = img.view();
+        for (tw, th) in [(1, 1), (1, 7), (3, 2), (7, 5), (15, 4), (16, 16), (17, 3)] {
+            if tw > w || th > h {
+                continue;
+            }
+            let at = Rect::new(w - tw, h - th, w, h);
+            correlation_agrees(&v, v.full(), at);
+            if w > tw + 2 && h > th + 1 {
+                correlation_agrees(&v, Rect::new(1, 1, w - 1, h), at.clamp_to(1, 1));
+            }
+        }
+        moravec_agrees(&v, v.full());
+        if w > 4 && h > 4 {
+            moravec_agrees(&v, Rect::new(1, 2, w - 2, h - 1));
+        }
+    }
+}
+
+#[test]
+fn rendered_frames_agree_on_every_path() {
+    let poses = [Pose2::new(0.5, -0.3, 0.05), Pose2::new(3.0, 0.2, 0.3)];
+    for (w, h) in [(640, 480), (641, 97), (17, 15)] {
+        for pose in poses {
+            let img = rendered(w, h, pose);
+            let v = img.view();
+            let side = 16.min(w as usize).min(h as usize);
+            let (cx, cy) = (w as usize / 2 - side / 2, h as usize / 2 - side / 2);
+            let at = Rect::new(cx, cy, cx + side, cy + side);
+            correlation_agrees(&v, v.full(), at);
+            moravec_agrees(&v, v.full());
+        }
+    }
+    // Coarse-to-fine over whole-frame and windowed pyramids, on each path.
+    let img = rendered(640, 480, poses[0]);
+    let v = img.view();
+    let at = Rect::new(300, 200, 332, 232);
+    let mut pt = Pyramid::default();
+    pt.build(&GrayBuf::crop(&v, at).expect("crop").view(), 3).expect("pyramid");
+    let win = Rect::new(270, 170, 366, 266);
+    let (mut whole, mut part) = (Pyramid::default(), Pyramid::default());
+    whole.build(&v, 3).expect("pyramid");
+    part.build_around(&v, win, 3).expect("pyramid");
+    let mut c = Correlator::default();
+    c.set_path(Path::Portable);
+    let want = format!("{:?}", coarse_to_fine(&whole, &pt, win, 2, &mut c));
+    for path in Path::available() {
+        c.set_path(path);
+        assert_eq!(format!("{:?}", coarse_to_fine(&whole, &pt, win, 2, &mut c)), want, "{path}");
+        assert_eq!(format!("{:?}", coarse_to_fine(&part, &pt, win, 2, &mut c)), want, "{path}, windowed");
+    }
+}
+
+/// Moving a rectangle inside `[x0, ..) x [y0, ..)`, keeping its size.
+trait ClampTo {
+    fn clamp_to(self, x0: usize, y0: usize) -> Rect;
+}
+
+impl ClampTo for Rect {
+    fn clamp_to(self, x0: usize, y0: usize) -> Rect {
+        let (dx, dy) = (x0.saturating_sub(self.x0), y0.saturating_sub(self.y0));
+        Rect::new(self.x0 + dx, self.y0 + dy, self.x1 + dx, self.y1 + dy)
+    }
+}
