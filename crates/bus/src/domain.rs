@@ -60,6 +60,8 @@ impl Bus {
             .config(&config)
             .create::<ipc::Service>()
             .map_err(|e| fail(format!("{e:?}")))?;
+        // The node has opened or created the domain's management segment: keep it private.
+        crate::shm::make_private(prefix);
         Ok(Self { node, prefix: prefix.to_owned() })
     }
 
@@ -126,8 +128,9 @@ pub fn cleanup_dead_nodes(prefix: &str) -> Result<usize> {
 }
 
 /// Removes every trace of a domain once none of its nodes lives: dead nodes' resources, then the
-/// shared-memory objects iceoryx2 keeps per prefix (its global management segment). Refuses while
-/// a node is alive. Returns how many shared-memory objects were removed.
+/// shared-memory objects iceoryx2 keeps per prefix (its global management segment). Only this
+/// domain's objects: not those of another domain whose prefix starts with this one. Refuses
+/// while a node is alive. Returns how many shared-memory objects were removed.
 pub fn retire_domain(prefix: &str) -> Result<usize> {
     let alive: Vec<NodeInfo> = live_nodes(prefix)?.into_iter().filter(|n| n.alive).collect();
     if !alive.is_empty() {
@@ -137,15 +140,6 @@ pub fn retire_domain(prefix: &str) -> Result<usize> {
         });
     }
     cleanup_dead_nodes(prefix)?;
-    let mut removed = 0;
-    if let Ok(dir) = std::fs::read_dir("/dev/shm") {
-        for entry in dir.flatten() {
-            if entry.file_name().to_string_lossy().starts_with(prefix)
-                && std::fs::remove_file(entry.path()).is_ok()
-            {
-                removed += 1;
-            }
-        }
-    }
+    let removed = crate::shm::domain_files(prefix).iter().filter(|f| std::fs::remove_file(f).is_ok()).count();
     Ok(removed)
 }

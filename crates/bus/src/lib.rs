@@ -16,6 +16,7 @@ mod domain;
 mod error;
 mod frames;
 mod pubsub;
+mod shm;
 mod waiter;
 
 pub use clock::{AFTER_ENV, CLOCK_ENV, Lockstep, PARTY_ENV, Pace, Step, lockstep_from_env};
@@ -25,6 +26,7 @@ pub use domain::{
 pub use error::BusError;
 pub use frames::{Frame, FrameLoan, FramePublisher, FrameSubscriber};
 pub use pubsub::{Publisher, Subscriber};
+pub use shm::domain_files;
 pub use waiter::{Attachment, FdSource, Waitable, Waiter, Wake};
 
 pub type Result<T> = std::result::Result<T, BusError>;

@@ -117,6 +117,7 @@ mod tests {
             Line::Report(Report::Nak { id: 4, reason: crate::NakReason::OutOfRange }),
             Line::Tick { time_ms: 1_250 },
             Line::Sync { time_ms: 1_250 },
+            Line::Heartbeat { time_ms: 1_300 },
         ]
     }
 
@@ -125,7 +126,7 @@ mod tests {
         let bytes: String = samples().iter().map(encode).collect();
         let (lines, stats) = decode_all(bytes.as_bytes());
         assert_eq!(lines, samples());
-        assert_eq!(stats, DecoderStats { frames: 10, ..DecoderStats::default() });
+        assert_eq!(stats, DecoderStats { frames: 11, ..DecoderStats::default() });
     }
 
     #[test]
@@ -143,9 +144,9 @@ mod tests {
         }
         let (lines, stats) = decode_all(&stream);
         assert_eq!(lines, good);
-        assert_eq!(stats.frames, 10);
-        assert_eq!(stats.truncated + stats.malformed + stats.bad_checksums, 10);
-        assert!(stats.garbage_bytes >= 7 + 5 * 10);
+        assert_eq!(stats.frames, 11);
+        assert_eq!(stats.truncated + stats.malformed + stats.bad_checksums, 11);
+        assert!(stats.garbage_bytes >= 7 + 5 * 11);
     }
 
     #[test]

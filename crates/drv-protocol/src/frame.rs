@@ -61,6 +61,11 @@ pub enum Line {
     Sync {
         time_ms: u64,
     },
+    /// Host → DRV, real time (a Harvey extension): the host, and the executive behind it, is
+    /// alive at the DRV's time `time_ms`; it feeds the DRV's watchdog between commands.
+    Heartbeat {
+        time_ms: u64,
+    },
 }
 
 /// What is wrong with a received frame.
@@ -110,6 +115,7 @@ pub fn encode(line: &Line) -> String {
         Line::Report(Report::Ack { id }) => write!(body, "AK {id}"),
         Line::Tick { time_ms } => write!(body, "TK {time_ms}"),
         Line::Sync { time_ms } => write!(body, "SY {time_ms}"),
+        Line::Heartbeat { time_ms } => write!(body, "HB {time_ms}"),
         Line::Report(Report::Nak { id, reason }) => write!(
             body,
             "NK {id} {}",
@@ -217,6 +223,10 @@ pub(crate) fn parse_frame(inner: &[u8]) -> Result<Line, FrameError> {
         "SY" => {
             arity(1)?;
             Line::Sync { time_ms: time(0)? }
+        }
+        "HB" => {
+            arity(1)?;
+            Line::Heartbeat { time_ms: time(0)? }
         }
         "AK" => {
             arity(1)?;

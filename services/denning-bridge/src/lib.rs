@@ -1,5 +1,10 @@
 //! The denning-bridge's logic: SI motion commands from the bus become DRV protocol commands (after
 //! checks), DRV reports become SI messages for the bus. The only place that knows DRV units.
+//! [`watchdog`] stops the vehicle when the executive falls silent.
+
+pub mod watchdog;
+
+pub use watchdog::{SHUTDOWN_STOP_ID, WATCHDOG_STOP_ID, Watchdog};
 
 use harvey_drv_protocol::{Command, NakReason, Report};
 use harvey_msgs::{CommandKind, EncodersRaw, Header, MotionCommand, SonarRaw};

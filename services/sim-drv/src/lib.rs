@@ -6,6 +6,7 @@
 
 pub mod motion;
 pub mod sonar;
+pub mod watchdog;
 
 use harvey_drv_protocol::{Command, NakReason, Report};
 use harvey_world::World;
@@ -70,6 +71,12 @@ impl SimDrv {
 
     pub fn is_moving(&self) -> bool {
         self.motion.is_some()
+    }
+
+    /// Abandons any motion at once, as the DRV's watchdog does (not a command: the last
+    /// command's id stays in the reports).
+    pub fn halt(&mut self) {
+        self.motion = None;
     }
 
     /// Accepts or refuses a command; the answer goes back on the line at once.

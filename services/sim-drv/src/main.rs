@@ -12,6 +12,7 @@ use harvey_drv_protocol::serial::{make_raw, read_available, set_nonblocking, wri
 use harvey_drv_protocol::{Decoder, Line, encode};
 use harvey_msgs::{Header, TruePose, topics};
 use harvey_sim_drv::SimDrv;
+use harvey_sim_drv::watchdog::HostWatchdog;
 
 #[derive(Parser)]
 #[command(about = "Simulated Denning DRV speaking the DRV protocol on a pseudo-terminal")]
@@ -38,6 +39,10 @@ struct Args {
     /// A launch file whose `[[mover]]` tables put moving things in the world.
     #[arg(long)]
     movers: Option<PathBuf>,
+    /// Stop when no frame has come from the host for this long of simulated time (the DRV's
+    /// watchdog; in lockstep every tick's `SY` feeds it).
+    #[arg(long, default_value_t = 200)]
+    watchdog_ms: u64,
 }
 
 fn main() -> anyhow::Result<()> {
@@ -84,6 +89,7 @@ fn main() -> anyhow::Result<()> {
     let mut decoder = Decoder::new();
     let (mut buf, mut lines) = (Vec::new(), Vec::new());
     let mut dropped_frames = 0u64;
+    let mut watchdog = HostWatchdog::new(args.watchdog_ms);
     let mut send = |line: &mut File, l: &Line| -> anyhow::Result<()> {
         dropped_frames += u64::from(!write_frame(line, encode(l).as_bytes())?);
         Ok(())
@@ -102,6 +108,7 @@ fn main() -> anyhow::Result<()> {
         });
         let mut due = !lockstep && Instant::now() >= next_tick;
         for l in &lines {
+            watchdog.feed(sim.time_ms());
             match *l {
                 Line::Command(cmd) => send(&mut line, &Line::Report(sim.handle(cmd)))?,
                 Line::Sync { time_ms } if lockstep => {
@@ -110,9 +117,11 @@ fn main() -> anyhow::Result<()> {
                     }
                     due = true;
                 }
+                Line::Heartbeat { .. } => {}
                 other => tracing::warn!(?other, "ignoring a frame the DRV does not take here"),
             }
             if due && lockstep {
+                guard(&mut sim, &watchdog);
                 tick(&mut sim, &truth_pub, args.tick_ms, |l| send(&mut line, l))?;
                 send(&mut line, &Line::Tick { time_ms: sim.time_ms() })?;
                 due = false;
@@ -120,12 +129,21 @@ fn main() -> anyhow::Result<()> {
         }
         if due {
             next_tick += period;
+            guard(&mut sim, &watchdog);
             tick(&mut sim, &truth_pub, args.tick_ms, |l| send(&mut line, l))?;
         }
     }
     let _ = std::fs::remove_file(&args.pty);
     tracing::info!(time_ms = sim.time_ms(), dropped_frames, stats = ?decoder.stats(), "simulated DRV stopped");
     Ok(())
+}
+
+/// The DRV's watchdog: a vehicle whose host has fallen silent stops before the next tick.
+fn guard(sim: &mut SimDrv, watchdog: &HostWatchdog) {
+    if sim.is_moving() && watchdog.lapsed(sim.time_ms()) {
+        tracing::error!(time_ms = sim.time_ms(), "no frame from the host within the deadline: stopping");
+        sim.halt();
+    }
 }
 
 /// Simulates one tick: the truth goes to the bus, the reports down the line.
