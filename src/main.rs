@@ -47,7 +47,7 @@ enum Cmd {
     },
     /// Topics, counts, rates, duration and gaps of a recording.
     Info { recording: PathBuf },
-    /// Salvage every chunk whose CRC checks of a recording whose writer died into a valid file.
+    /// Salvage a recording whose writer died: every chunk whose CRC checks, into a valid file.
     Recover {
         recording: PathBuf,
         #[arg(short, long)]
