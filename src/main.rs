@@ -42,6 +42,10 @@ enum Cmd {
         /// draws one afterwards).
         #[arg(long)]
         rrd: bool,
+        /// Start whatever binaries the recording's launch file names; without it, only Harvey's
+        /// own service binaries (a recording is data from elsewhere).
+        #[arg(long)]
+        trust_recording: bool,
         #[command(flatten)]
         opts: LaunchArgs,
     },
@@ -101,7 +105,9 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
     match cmd {
         Cmd::Run { mission, opts } => cmd::run::run(mission.as_deref(), &opts),
         Cmd::Launch { file, opts } => cmd::launch::run(&file, &opts),
-        Cmd::Replay { recording, check, rrd, opts } => cmd::replay::run(&recording, check, rrd, opts),
+        Cmd::Replay { recording, check, rrd, trust_recording, opts } => {
+            cmd::replay::run(&recording, check, rrd, trust_recording, opts)
+        }
         Cmd::Info { recording } => cmd::info::run(&recording),
         Cmd::Diff { a, b } => cmd::diff::run(&a, &b),
         Cmd::Recover { recording, output } => cmd::recover::run(&recording, &output),

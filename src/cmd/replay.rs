@@ -13,11 +13,16 @@ use super::{LaunchArgs, launch_file, report_comparison};
 /// the new recording and Rerun file (as the launches name them), the world and the launch.
 const WRITTEN: [&str; 4] = ["run.mcap", "run.rrd", "world.toml", LAUNCH_FILE];
 
-pub fn run(recording: &Path, check: bool, rrd: bool, opts: LaunchArgs) -> anyhow::Result<i32> {
+/// `trust`: start whatever binaries the recording's launch file names (`--trust-recording`);
+/// without it only Harvey's own service binaries.
+pub fn run(recording: &Path, check: bool, rrd: bool, trust: bool, opts: LaunchArgs) -> anyhow::Result<i32> {
+    // Every argument is checked before anything is written.
+    harvey_bus::validate_prefix(&opts.prefix)?;
     let run_dir =
         opts.run_dir.clone().unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
     refuse_writing_over(recording, &run_dir)?;
-    let file = prepare(recording, &run_dir, rrd)?;
+    let file = prepare(recording, &run_dir, rrd, trust)?;
+    println!("replaying: {} (the launch {} carries)", file.display(), recording.display());
     let (outcome, _) = launch_file(&file, &LaunchArgs { run_dir: Some(run_dir.clone()), ..opts })?;
     println!("replay: {outcome:?}");
     let again = run_dir.join("run.mcap");
@@ -55,6 +60,27 @@ fn refuse_writing_over(recording: &Path, run_dir: &Path) -> anyhow::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_recording_that_would_start_a_foreign_binary_is_refused_before_anything_is_written() {
+        let dir = std::env::temp_dir().join(format!("harvey-replay-trust-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("tmp");
+        let recording = dir.join("crafted.mcap");
+        let mut r = harvey_recording::Recorder::create(&recording).expect("create");
+        let launch = "[launch]\nname = \"l\"\nend_with = \"ums\"\n[[service]]\nname = \"sim-drv\"\n\
+                      [[service]]\nname = \"ums\"\nbinary = \"/bin/sh\"\nargs = [\"-c\", \"true\"]\n";
+        r.attach_launch("l.toml", launch).expect("launch");
+        r.attach_world("w.toml", "name = \"w\"\n", 1).expect("world");
+        r.finish().expect("finish");
+        let run_dir = dir.join("replay");
+        let e = prepare(&recording, &run_dir, false, false).expect_err("refused").to_string();
+        assert!(e.contains("ums (/bin/sh)") && e.contains("--trust-recording"), "{e}");
+        assert!(!run_dir.exists(), "nothing is written for a refused replay");
+        let opts = LaunchArgs { run_dir: Some(dir.join("other")), prefix: "bad prefix".into() };
+        assert!(run(&recording, false, false, false, opts).is_err(), "a bad prefix is refused");
+        assert!(!dir.join("other").exists(), "before anything is written");
+        std::fs::remove_dir_all(&dir).ok();
+    }
 
     #[test]
     fn a_replay_never_writes_into_the_recording_it_replays() {

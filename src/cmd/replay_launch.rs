@@ -12,10 +12,21 @@ use harvey_recording::ticks::INPUT_SERVICES;
 pub const LAUNCH_FILE: &str = "replay.toml";
 
 /// Writes the replay's launch and world files into `run_dir`; returns the launch file's path.
-pub fn prepare(recording: &Path, run_dir: &Path, rrd: bool) -> anyhow::Result<PathBuf> {
+/// Unless `trust`, a launch that would start anything but Harvey's own service binaries is
+/// refused before a file is written.
+pub fn prepare(recording: &Path, run_dir: &Path, rrd: bool, trust: bool) -> anyhow::Result<PathBuf> {
     let name = recording.display().to_string();
     let rec = Recording::open(recording)?;
     let (world, launch) = (rec.world_text()?, rec.launch_text()?);
+    let text =
+        replay_launch(&launch, recording, rrd).with_context(|| format!("{name}: attached launch file"))?;
+    let foreign = foreign_binaries(&text)?;
+    anyhow::ensure!(
+        trust || foreign.is_empty(),
+        "{name}: its launch file would start {}, not Harvey's own service binaries; replay it only \
+         if you trust the recording (--trust-recording)",
+        foreign.join(", ")
+    );
     std::fs::create_dir_all(run_dir).with_context(|| format!("creating {}", run_dir.display()))?;
     let original = std::fs::canonicalize(recording).with_context(|| format!("resolving {name}"))?;
     let output = std::fs::canonicalize(run_dir)?.join("run.mcap");
@@ -35,6 +46,26 @@ pub fn prepare(recording: &Path, run_dir: &Path, rrd: bool) -> anyhow::Result<Pa
     let path = run_dir.join(LAUNCH_FILE);
     std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
     Ok(path)
+}
+
+/// The services of launch text `text` whose binary is not one of Harvey's own (named
+/// `harvey-<something>` and found beside the CLI or on the PATH, no path given), as
+/// `service (binary)`.
+pub fn foreign_binaries(text: &str) -> anyhow::Result<Vec<String>> {
+    let doc: toml::Table = text.parse()?;
+    let services = doc.get("service").and_then(|s| s.as_array()).map(Vec::as_slice).unwrap_or_default();
+    Ok(services
+        .iter()
+        .filter_map(|s| {
+            let name = s.get("name").and_then(|n| n.as_str()).unwrap_or_default();
+            let binary =
+                s.get("binary").and_then(|b| b.as_str()).map_or(format!("harvey-{name}"), str::to_owned);
+            let own = binary.starts_with("harvey-")
+                && binary.len() > "harvey-".len()
+                && binary.chars().all(|c| c.is_ascii_alphanumeric() || c == '-');
+            (!own).then(|| format!("{name} ({binary})"))
+        })
+        .collect())
 }
 
 /// The launch file of a replay of `recording`, from the launch file that recorded it. Without
@@ -74,6 +105,21 @@ pub fn replay_launch(text: &str, recording: &Path, rrd: bool) -> anyhow::Result<
     replayer.insert("restart".into(), "never".into());
     services.insert(at, replayer.into());
     Ok(toml::to_string(&doc)?)
+}
+
+#[cfg(test)]
+mod trust_tests {
+    use super::foreign_binaries;
+
+    #[test]
+    fn only_harvey_service_binaries_are_trusted() {
+        let own = "[launch]\nname = \"x\"\n[[service]]\nname = \"ums\"\n[[service]]\nname = \"r\"\nbinary = \"harvey-recorder\"\n";
+        assert!(foreign_binaries(own).expect("parses").is_empty());
+        for bad in ["/bin/sh", "sh", "harvey-", "../harvey-ums", "harvey-ums; rm", "/usr/bin/harvey-ums"] {
+            let text = format!("[launch]\nname = \"x\"\n[[service]]\nname = \"evil\"\nbinary = \"{bad}\"\n");
+            assert_eq!(foreign_binaries(&text).expect("parses"), [format!("evil ({bad})")], "{bad}");
+        }
+    }
 }
 
 #[cfg(test)]
