@@ -1,8 +1,9 @@
 //! `harvey recover`: salvages a recording whose writer died (SIGKILL, power loss) or whose bytes
 //! are damaged into a valid MCAP file: every message of every chunk whose CRC checks (`salvage.rs`),
-//! the attachments whose CRC checks, the metadata, in order. What the dead writer had not yet
-//! flushed is gone, a damaged chunk is skipped (never written again under a fresh CRC); how far
-//! the salvage got, and what it skipped where, is reported.
+//! the attachments whose CRC checks, the metadata, in order; a message outside chunks only when
+//! the data section's CRC vouches for it. What the dead writer had not yet flushed is gone, a
+//! damaged chunk is skipped (never written again under a fresh CRC); how far the salvage got, and
+//! what it skipped where, is reported.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -18,11 +19,14 @@ use crate::{RECOVER_METADATA, Recording, RecordingError, salvage};
 pub struct Salvage {
     pub messages: u64,
     pub attachments: u64,
-    /// File offsets of the chunks skipped: their CRC did not check (or there was none to check
-    /// them by), or their records did not parse or link to a channel.
+    /// File offsets of the chunks skipped: their CRC did not check (or was 0, and the data
+    /// section's CRC did not vouch for them either), or their records did not parse or link to a
+    /// channel.
     pub damaged_chunks: Vec<u64>,
     /// File offsets of the other records skipped: attachments whose CRC does not check, records
-    /// that do not parse.
+    /// that do not parse or link, and the records nothing vouches for: schemas, channels and
+    /// messages outside chunks (and attachments whose CRC is 0) when the data section's CRC is
+    /// not there to check them, or does not match.
     pub damaged_records: Vec<u64>,
     /// The data section's CRC does not match though every chunk and attachment does: a record
     /// without a CRC of its own (metadata, a message index) is damaged, and was copied.
@@ -72,7 +76,9 @@ pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordingError> {
     if !bytes.starts_with(mcap::MAGIC) {
         return Err(RecordingError::NoMagic { file: input.to_owned() });
     }
-    let records = salvage::records(bytes);
+    // What alone vouches for the records without a CRC of their own.
+    let vouched = salvage::data_crc_vouches(bytes);
+    let records = salvage::records(bytes, vouched);
     let out =
         File::create(output).map_err(|cause| RecordingError::Create { file: output.to_owned(), cause })?;
     let oerr = |cause| RecordingError::Write { file: output.to_owned(), cause };
@@ -88,8 +94,8 @@ pub fn recover(input: &Path, output: &Path) -> Result<Salvage, RecordingError> {
         w.write_metadata(m).map_err(oerr)?;
     }
     let mut messages = 0;
-    // Channels a damaged chunk defined are still known from the summary, when it reads.
-    let mut salvaged = salvage::Messages::new(bytes, recording.summary_if_any());
+    // Channels a damaged chunk defined are still known from the summary, when its CRC checks.
+    let mut salvaged = salvage::Messages::new(bytes, recording.summary_if_any(), vouched);
     for chunk in salvaged.by_ref() {
         for m in &chunk {
             w.write(m).map_err(oerr)?;

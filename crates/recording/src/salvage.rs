@@ -1,8 +1,14 @@
 //! What `harvey recover` can take from a recording whose writer died or whose bytes are damaged,
 //! read through the crate's checked readers: the data section's records up to its end (or to the
-//! first record that runs past the file), and of its chunks only those whose CRC checks and whose
-//! records all parse and link. A damaged chunk is skipped and its offset kept; nothing that could
-//! not be verified is handed on to be written with a fresh CRC.
+//! first record that runs past the file), and of those only what a CRC vouches for. A chunk is
+//! taken when its own CRC checks and its records all parse and link; an attachment when its own
+//! CRC checks. A record without a CRC of its own (a schema, channel or message outside chunks, a
+//! chunk or attachment whose CRC is 0, "not computed") is taken only when the data section's CRC
+//! is there and checks: a message index whose opcode a flipped bit made a message's, or the bytes
+//! a damaged length makes the walk land in, parse as well as a real record does. What is skipped
+//! is kept by offset; nothing that could not be verified is handed on to be written with a fresh
+//! CRC (the metadata records, which nothing but the data section's CRC covers, are copied, and a
+//! data section CRC that does not match is reported).
 
 use mcap::read::ChannelAccumulator;
 use mcap::records::{Metadata, Record, op};
@@ -15,8 +21,8 @@ pub(crate) struct Records<'a> {
     pub profile: String,
     pub attachments: Vec<mcap::Attachment<'a>>,
     pub metadata: Vec<Metadata>,
-    /// Offsets of the records skipped: attachments whose CRC does not check, records that do not
-    /// parse.
+    /// Offsets of the records skipped: attachments whose CRC does not check (or is 0, with nothing
+    /// else to vouch for them), records that do not parse.
     pub damaged: Vec<u64>,
     /// Where and why the data section stopped before its data end record.
     pub stopped_at: Option<String>,
@@ -24,8 +30,24 @@ pub(crate) struct Records<'a> {
     pub bad_data_crc: bool,
 }
 
-/// The header, attachments and metadata of the data section, and where it stops.
-pub(crate) fn records(bytes: &[u8]) -> Records<'_> {
+/// Whether the data section's CRC vouches for every record of it: the data end record is reached,
+/// and its CRC is not 0 ("not computed") and matches the bytes before it.
+pub(crate) fn data_crc_vouches(bytes: &[u8]) -> bool {
+    for raw in DataSection::new(bytes) {
+        let Ok(raw) = raw else { return false };
+        if raw.opcode == op::DATA_END {
+            let Ok(Record::DataEnd(end)) = raw.parse() else { return false };
+            let saved = end.data_section_crc;
+            return saved != 0 && saved == crc32fast::hash(&bytes[..raw.offset]);
+        }
+    }
+    false
+}
+
+/// The header, attachments and metadata of the data section, and where it stops. An attachment
+/// without a CRC (0) is taken only when `vouched`: the data section's CRC checks
+/// ([`data_crc_vouches`]).
+pub(crate) fn records(bytes: &[u8], vouched: bool) -> Records<'_> {
     let mut out = Records {
         profile: String::new(),
         attachments: Vec::new(),
@@ -47,13 +69,17 @@ pub(crate) fn records(bytes: &[u8]) -> Records<'_> {
         }
         match raw.parse() {
             Ok(Record::Header(h)) => out.profile = h.profile,
-            Ok(Record::Attachment { header, data, .. }) => out.attachments.push(mcap::Attachment {
-                log_time: header.log_time,
-                create_time: header.create_time,
-                name: header.name,
-                media_type: header.media_type,
-                data,
-            }),
+            // mcap has checked a CRC that is not 0.
+            Ok(Record::Attachment { header, data, crc }) if crc != 0 || vouched => {
+                out.attachments.push(mcap::Attachment {
+                    log_time: header.log_time,
+                    create_time: header.create_time,
+                    name: header.name,
+                    media_type: header.media_type,
+                    data,
+                });
+            }
+            Ok(Record::Attachment { .. }) => out.damaged.push(raw.offset as u64),
             Ok(Record::Metadata(m)) => out.metadata.push(m),
             Ok(Record::DataEnd(end)) => {
                 let saved = end.data_section_crc;
@@ -66,34 +92,43 @@ pub(crate) fn records(bytes: &[u8]) -> Records<'_> {
     out
 }
 
-/// The messages of the data section, a verified chunk's worth (or one message outside a chunk)
-/// at a time; the chunks and records skipped are counted by offset.
+/// The messages of the data section, a verified chunk's worth (or one vouched-for message outside
+/// a chunk) at a time; the chunks and records skipped are counted by offset.
 pub(crate) struct Messages<'a> {
     records: DataSection<'a>,
     channels: ChannelAccumulator<'static>,
+    /// Whether the data section's CRC checks ([`data_crc_vouches`]): what alone vouches for the
+    /// records outside chunks, and for a chunk whose CRC is 0.
+    vouched: bool,
     /// Offsets of the chunks skipped.
     pub damaged_chunks: Vec<u64>,
-    /// Offsets of schema, channel and message records outside chunks that were skipped.
+    /// Offsets of schema, channel and message records outside chunks that were skipped: they do
+    /// not parse or link, or (all of them) the data section's CRC does not vouch for them.
     pub damaged_records: Vec<u64>,
 }
 
 impl<'a> Messages<'a> {
-    /// The messages of `bytes`, linked to the channels of `summary` (when it reads) as well as to
-    /// those the file defines as it goes: a chunk that defined a channel may be the damaged one.
-    pub fn new(bytes: &'a [u8], summary: Option<&mcap::Summary>) -> Self {
-        let channels = summary.map(ChannelAccumulator::from_summary).unwrap_or_default();
+    /// The messages of `bytes`, linked to the channels of `summary` (when it reads and had a CRC
+    /// to check it by) as well as to those the file defines as it goes: a chunk that defined a
+    /// channel may be the damaged one. `vouched`: whether the data section's CRC checks.
+    pub fn new(bytes: &'a [u8], summary: Option<&mcap::Summary>, vouched: bool) -> Self {
+        // `summary::read` checks the summary's CRC unless it is 0; then nothing vouches for it.
+        let checked = crate::summary::footer(bytes).is_ok_and(|f| f.summary_crc != 0);
+        let channels = summary.filter(|_| checked).map(ChannelAccumulator::from_summary).unwrap_or_default();
         Self {
             records: DataSection::new(bytes),
             channels,
+            vouched,
             damaged_chunks: Vec::new(),
             damaged_records: Vec::new(),
         }
     }
 
-    /// The messages of a chunk that verifies, parses and links throughout; `None` when it does not.
+    /// The messages of a chunk that verifies (by its own CRC, or by the data section's when its
+    /// own is 0), parses and links throughout; `None` when it does not.
     fn chunk(&mut self, raw: Raw<'_>) -> Option<Vec<mcap::Message<'static>>> {
         let Ok(Record::Chunk { header, data }) = raw.parse() else { return None };
-        let opened = chunk::open(&header, &data).ok().filter(|o| o.verified)?;
+        let opened = chunk::open(&header, &data).ok().filter(|o| o.verified || self.vouched)?;
         let mut parsed = Vec::new();
         let mut at = 0;
         while at < opened.records.len() {
@@ -147,6 +182,10 @@ impl Iterator for Messages<'_> {
                     Some(messages) => return Some(messages),
                     None => self.damaged_chunks.push(raw.offset as u64),
                 },
+                // No CRC of their own: only the data section's can vouch for them.
+                op::SCHEMA | op::CHANNEL | op::MESSAGE if !self.vouched => {
+                    self.damaged_records.push(raw.offset as u64);
+                }
                 op::SCHEMA | op::CHANNEL | op::MESSAGE => {
                     match raw.parse().map_err(drop).and_then(|r| link(&mut self.channels, r)) {
                         Ok(Some(message)) => return Some(vec![message]),

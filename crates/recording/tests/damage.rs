@@ -1,7 +1,8 @@
 //! The damage the issue found, one case each on the harness's sample recording: a flipped pixel
 //! under an intact CRC field (every tool used to accept it, and `recover` wrote it again under a
 //! fresh CRC), an 8.9e18-byte length (an allocation abort), a length past the file (a panic in
-//! mcap), and `export`/`recover` asked to write over their input.
+//! mcap), a message index turned into a message by one flipped bit (which `recover` used to write
+//! as a message), and `export`/`recover` asked to write over their input.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 #[allow(dead_code, reason = "the harness's sample and readers only")]
@@ -124,6 +125,35 @@ fn a_string_length_past_its_record_is_an_error_not_a_panic() {
     std::fs::write(&path, &b).unwrap();
     let e = error_of(message_prints(&path));
     assert!(e.contains(&format!("at byte {at}: record 0x09: a length field at byte 16")), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn a_message_index_a_flipped_bit_made_a_message_is_not_salvaged_as_one() {
+    let (dir, path, bytes) = sample("opcode");
+    // The first message index after a chunk: opcode 0x07, one bit from a message's 0x05. Its body
+    // parses as a message on the channel it indexes, and no CRC of its own says otherwise.
+    let (mut at, mut index) = (8, None);
+    while at + 9 <= bytes.len() && bytes[at] != 0x0F {
+        if bytes[at] == 0x07 {
+            index = Some(at);
+            break;
+        }
+        at += 9 + u64::from_le_bytes(bytes[at + 1..at + 9].try_into().unwrap()) as usize;
+    }
+    let at = index.expect("a message index in the data section");
+    let mut b = bytes.clone();
+    b[at] ^= 0b10;
+    let damaged = dir.join("opcode.mcap");
+    std::fs::write(&damaged, &b).unwrap();
+
+    let out = dir.join("recovered.mcap");
+    let s = recover::recover(&damaged, &out).unwrap();
+    assert_eq!((s.damaged_chunks.as_slice(), s.damaged_records.as_slice()), (&[][..], &[at as u64][..]));
+    assert!(!s.is_whole() && s.losses().contains(&format!("1 damaged record skipped at offset {at}")));
+    let (original, salvaged) = (message_prints(&path).unwrap(), message_prints(&out).unwrap());
+    assert_eq!(salvaged, original, "every chunk's messages, and nothing else");
+    assert_eq!(s.messages as usize, salvaged.len());
     std::fs::remove_dir_all(&dir).ok();
 }
 
