@@ -4,7 +4,7 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use harvey_msgs::{CheckOutcome, MissionState, MissionStatus, PlanSketch, TruePose, UncertaintyMap};
+use harvey_msgs::{CheckOutcome, MissionState, MissionStatus, PlanSketch, PoseFix, TruePose, UncertaintyMap};
 use harvey_recording::Recording;
 
 /// One line of the summary: a labelled pose, its heading in (-180, 180] degrees.
@@ -45,6 +45,8 @@ pub struct RunStats {
     /// The largest distance of the true path from the line through its first pose along that
     /// pose's heading (000 §5.5's offset from the line); `None` without `sim/truth`.
     pub line_offset_m: Option<f64>,
+    /// Each pose fix's distance from the true pose when its frames were taken (metres).
+    pub fix_errors_m: Vec<f64>,
 }
 
 /// A run's figures as data (`harvey sweep` tabulates them): the numbers the mission summary
@@ -58,6 +60,8 @@ pub struct Figures {
     /// The summary's "final error … from the goal" (not for a pole hunt).
     pub final_error_m: Option<f64>,
     pub line_offset_m: Option<f64>,
+    /// The worst pose fix's distance from the truth (metres); `None` without fixes.
+    pub fix_error_m: Option<f64>,
     /// Poles visited and poles in the field.
     pub poles: Option<(usize, usize)>,
     /// The acceptor's states (empty without a sequenced behaviour) and what it achieved.
@@ -72,6 +76,7 @@ impl RunStats {
         let mut true_path: Vec<(f64, [f64; 2])> = Vec::new();
         // The line of `line_offset_m`: the first true pose's x, y, cos and sin of its heading.
         let mut line: Option<[f64; 4]> = None;
+        let mut fixes: Vec<PoseFix> = Vec::new();
         for m in recording.messages()? {
             let m = m?;
             let topic = m.topic().to_owned();
@@ -97,7 +102,10 @@ impl RunStats {
                     run.last_truth = Some(t);
                 }
                 "ums/map" => run.last_map = Some(m.decode()?),
-                "executive/pose" => run.fixes += 1,
+                "executive/pose" => {
+                    run.fixes += 1;
+                    fixes.push(m.decode::<PoseFix>()?);
+                }
                 "executive/behaviour" => {
                     let b: harvey_msgs::BehaviourState = m.decode()?;
                     if run.fsa_trace.last() != Some(&b.fsa_state) {
@@ -119,6 +127,13 @@ impl RunStats {
                     run.last_plan = Some(p);
                 }
                 _ => {}
+            }
+        }
+        for f in &fixes {
+            let at_s = f.header.stamp_ns as f64 / 1e9;
+            let truth = true_path.iter().rev().find(|(t, _)| *t <= at_s + 1e-9);
+            if let Some((_, [x, y])) = truth {
+                run.fix_errors_m.push((f.refined.x_m - x).hypot(f.refined.y_m - y));
             }
         }
         match recording.world() {
@@ -168,6 +183,7 @@ impl RunStats {
             state: self.last_status.as_ref().and_then(MissionStatus::state),
             end_s: self.last_status.as_ref().map(|s| s.header.stamp_ns as f64 / 1e9),
             line_offset_m: self.line_offset_m,
+            fix_error_m: self.fix_errors_m.iter().copied().reduce(f64::max),
             trace: self.fsa_trace.clone(),
             achieved: self.achieved,
             ..Figures::default()
@@ -237,6 +253,14 @@ impl RunStats {
                 "  plan-and-monitor: {} milestone checks ({reached} reached, {retried} retried, {replanned} replanned), {} pose fixes\n",
                 reached + retried + replanned,
                 self.fixes
+            );
+        }
+        if let Some(worst) = self.fix_errors_m.iter().copied().reduce(f64::max) {
+            out += &format!(
+                "  pose fixes: {}, at most {:.3} m ({:.2} in) from the truth\n",
+                self.fix_errors_m.len(),
+                worst,
+                worst / 0.0254
             );
         }
         if !self.fsa_trace.is_empty() {

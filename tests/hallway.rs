@@ -70,9 +70,14 @@ fn servoing_holds_the_line_for_40_ft_where_open_loop_wanders_off_it() {
     println!("servoed: {:.2} ft travelled, at most {:.3} in off the line", travelled / FT, held / INCH);
     // 40 ft commanded; tile's translational loss (002 Table 3, 4.2 %) leaves it about 38 ft.
     assert!(travelled > 37.5 * FT, "{} ft", travelled / FT);
-    assert!(held <= 0.3 * INCH, "servoed: {} in off the line", held / INCH);
-    // A look after each of the 20 increments, each finding the sign.
-    assert_eq!(looks.len(), 20);
+    // 000 Fig. 11: within 0.3 in, on an exact map. The shipped hallway is built 1 cm (sd) off its
+    // map (`[map_error]`), and the robot measures its mount's misalignment against the sign's
+    // mapped place, so the line it holds is itself off by up to 1 cm x 12 m / 17 m = 0.28 in
+    // (1 sd): the bound is the paper's plus that.
+    assert!(held <= 0.58 * INCH, "servoed: {} in off the line", held / INCH);
+    // A look before the first increment (the mount's boresight) and after each of the 20, each
+    // finding the sign.
+    assert_eq!(looks.len(), 21);
     assert!(looks.iter().all(|r| r.status == VisionStatus::Found as u32 && r.items[0].values[2] >= 0.9));
     // Each look's correction is published (and drawn in run.rrd), after increments 1 to 20;
     // the drift of an increment is well under 2 degrees.

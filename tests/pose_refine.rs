@@ -42,6 +42,8 @@ fn expected_poses_inches_off_are_refined_to_within_an_inch_and_a_half() {
         // ...and the vertices put it back.
         assert!(off(f.refined) < 1.5, "refined {} in from the truth: {f:?}", off(f.refined));
         assert!((f.refined.heading_rad - t.heading_rad).abs() < 0.2f64.to_radians(), "{f:?}");
-        assert!(f.found == f.asked && f.kept + 2 >= f.asked && f.rms_px < 1.0, "{f:?}");
+        // The residual: correlation under noise, plus the mount's unknown pitch (3 mrad sd in the
+        // shipped worlds: 1.7 px up or down) that a pose (x, y, heading) cannot take up.
+        assert!(f.found == f.asked && f.kept + 2 >= f.asked && f.rms_px < 2.5, "{f:?}");
     }
 }

@@ -94,7 +94,7 @@ fn a_sweep_tabulates_each_runs_figure_per_seed_and_condition() {
         (w.camera.illumination, w.camera.noise_sd, w.camera.vignetting)
     };
     assert_eq!(camera("dim-s2"), (170.0, 5.0, 0.25));
-    assert_eq!(camera("nominal-s2"), (220.0, 0.0, 0.0));
+    assert_eq!(camera("nominal-s2"), (220.0, 3.0, 0.2), "the hallway's own camera");
 
     let md = std::fs::read_to_string(out.join("sweep.md")).expect("md");
     assert!(md.contains("| condition | runs | successes | success rate | median | p90 | worst |"), "{md}");
@@ -108,7 +108,7 @@ fn a_sweep_tabulates_each_runs_figure_per_seed_and_condition() {
 fn bad_conditions_and_empty_seed_ranges_are_refused_naming_file_line_and_key() {
     let dir = common::scratch("sweep-bad");
     let cases = [
-        ("unknown.toml", "[camera]\nnoise_sd = 2\nblur_px = 1\n", ":3: key `camera.blur_px`"),
+        ("unknown.toml", "[camera]\nnoise_sd = 2\nfisheye = 1\n", ":3: key `camera.fisheye`"),
         ("vignette.toml", "[camera]\nvignetting = 1.0\n", ":2: key `camera.vignetting`"),
         ("noise.toml", "# negative noise\n[camera]\nnoise_sd = -0.5\n", ":3: key `camera.noise_sd`"),
     ];

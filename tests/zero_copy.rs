@@ -78,11 +78,23 @@ fn check(width: u32, height: u32, encoding: Encoding) {
     let (_, _, file) = inside.expect("checked");
     assert!(file.contains(&prefix), "mapping {file} is not of this test's bus domain {prefix}");
 
-    let world = harvey_world::World::load(&world_path).expect("world");
-    let mut renderer = Renderer::new(&world, width, height, encoding);
+    // What the camera renders (its default seed, 1): the world as built, through its misaligned
+    // mount, with the world's imaging effects for this frame.
+    let world = harvey_world::World::load(&world_path).expect("world").as_built(1);
+    let (yaw, pitch) = harvey_render::mount_error(&world.camera, 1);
+    let mut renderer = Renderer::new(&world, width, height, encoding).misaligned(yaw, pitch);
     let mut expected = vec![0u8; renderer.frame_bytes()];
     let from = harvey_world::Pose2::from_degrees(pose[0], pose[1], pose[2]);
     renderer.render(&world, from, &mut expected).expect("render");
+    let bpp = encoding.bytes_per_pixel() as usize;
+    harvey_render::Effects::from_camera(&world.camera, 1).apply_at(
+        width as usize,
+        height as usize,
+        bpp,
+        h.seq,
+        h.stamp_ns,
+        &mut expected,
+    );
     assert_eq!(checksum(pixels), checksum(&expected), "frame content differs from the render");
 
     drop(frame);

@@ -69,12 +69,17 @@ impl Launch {
 
     /// The world as a service loads it: with the poles placed by `poles_seed`, the launch
     /// file's movers and another start, when asked for.
-    pub fn world(&self, poles_seed: Option<u64>, movers: bool, start: Option<Pose2>) -> harvey_world::World {
+    /// The world file as the robot's map (`sim_seed` None), or as built for the simulator's run
+    /// of `sim_seed`, its poles placed.
+    pub fn world(&self, sim_seed: Option<u64>, movers: bool, start: Option<Pose2>) -> harvey_world::World {
         let mut w = harvey_world::World::load(&self.world).expect("the world");
+        if let Some(seed) = sim_seed {
+            w = w.as_built(seed);
+        }
         if let Some(s) = start {
             w.start = s;
         }
-        if let Some(seed) = poles_seed {
+        if let Some(seed) = sim_seed {
             w.place_poles(seed).expect("room for the poles");
         }
         if movers {

@@ -29,6 +29,8 @@ fn beliefs_inches_off_are_refined_to_within_an_inch_and_a_half_of_the_truth() {
         assert!((believed_in - wanted_in).abs() < 1.5, "{f:?}");
         assert!(off_in < 1.5, "refined {off_in:.2} in from the truth: {f:?}");
         assert!((f.refined.heading_rad - t.heading_rad).abs() < 0.2f64.to_radians(), "{f:?}");
-        assert!(f.found == f.asked && f.kept >= 3 && f.rms_px < 1.0, "{f:?}");
+        // The residual: correlation under noise, plus the mount's unknown pitch (3 mrad sd in the
+        // shipped worlds: 1.7 px up or down) that a pose (x, y, heading) cannot take up.
+        assert!(f.found == f.asked && f.kept >= 3 && f.rms_px < 2.5, "{f:?}");
     }
 }

@@ -16,7 +16,7 @@ use harvey_msgs::{
     Encoding, Expectation, FrameHeader, LandmarkSighting, MissionState, MotionCommand, Odometry, Pose2,
     PoseFix, UncertaintyMap, VisionRequest,
 };
-use harvey_render::{Effects, Renderer};
+use harvey_render::{Effects, Renderer, mount_error};
 use harvey_sim_drv::SimDrv;
 use harvey_sonar::SonarRingBuilder;
 use harvey_sonar::avoid::{AvoidParams, PanicAvoid};
@@ -60,7 +60,7 @@ impl Camera {
         self.renderer.render(&self.world, pose, &mut self.pixels).expect("renders");
         let (w, ht, bpp) =
             (h.width_px as usize, h.height_px as usize, (h.stride_bytes / h.width_px) as usize);
-        self.effects.apply(w, ht, bpp, self.seq, &mut self.pixels);
+        self.effects.apply_at(w, ht, bpp, self.seq, h.stamp_ns, &mut self.pixels);
         Some(h)
     }
 }
@@ -107,8 +107,10 @@ impl Rig {
         let world = l.world(None, false, None);
         let cam_world = l.world(Some(l.camera_seed), l.camera_movers, None);
         let c = &cam_world.camera;
-        let renderer = Renderer::new(&cam_world, c.width_px, c.height_px, Encoding::Mono8);
-        let effects = Effects { vignetting: c.vignetting, noise_sd: c.noise_sd, seed: l.camera_seed };
+        let (yaw, pitch) = mount_error(c, l.camera_seed);
+        let renderer =
+            Renderer::new(&cam_world, c.width_px, c.height_px, Encoding::Mono8).misaligned(yaw, pitch);
+        let effects = Effects::from_camera(c, l.camera_seed);
         let pixels = vec![0; renderer.frame_bytes()];
         let camera =
             Camera { renderer, effects, every: l.camera_every.max(1), seq: 0, pixels, world: cam_world };
@@ -144,7 +146,8 @@ impl Rig {
             avoid,
             encoders: OdometryBuilder::default(),
             camera,
-            lines: LineLandmarks::new(world.camera.focal_px, EDGE_THRESHOLD),
+            lines: LineLandmarks::new(world.camera.focal_px, EDGE_THRESHOLD)
+                .with_calibration_sd(world.survey.calibration_sd_rad),
             dispatcher: Dispatcher::new(world),
             edges: VerticalEdges::new(BAND_HALF_ROWS, EDGE_THRESHOLD),
             wanted: BTreeMap::new(),

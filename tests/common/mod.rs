@@ -137,6 +137,28 @@ pub fn run_mission(mission: &str, tag: &str) -> MissionRun {
     }
 }
 
+/// Runs `mission` at `seed` under a sensor condition (`conditions/NAME.toml`), as `harvey sweep`
+/// does: the run's recording and its `harvey run` output (as stdout; the sweep's own output as
+/// stderr); the status is the sweep's (success when the run reached its goal).
+#[allow(dead_code)]
+pub fn run_mission_under(mission: &str, condition: &str, seed: u64, tag: &str) -> MissionRun {
+    let (prefix, dir) = (unique_prefix(tag), scratch(tag));
+    let seeds = seed.to_string();
+    let args = ["sweep", mission, "--seeds", &seeds, "--conditions", condition, "--jobs", "1", "--keep"];
+    let out = harvey(&args)
+        .args(["--out", dir.to_str().expect("utf8"), "--prefix", &prefix])
+        .output()
+        .expect("runs");
+    let run = dir.join("runs").join(format!("{condition}-s{seed}"));
+    MissionRun {
+        status: out.status,
+        stdout: std::fs::read_to_string(run.join("harvey-run.log")).unwrap_or_default(),
+        stderr: String::from_utf8_lossy(&out.stdout).into_owned() + &String::from_utf8_lossy(&out.stderr),
+        mcap: std::fs::read(run.join("run.mcap")).unwrap_or_default(),
+        dir,
+    }
+}
+
 /// Whether the map holds a pose: inside its convex polygon (with `tol`) and its heading wedge.
 pub fn holds(m: &harvey_msgs::UncertaintyMap, x: f64, y: f64, th: f64, tol: f64) -> bool {
     let n = m.vertex_count as usize;

@@ -2,9 +2,10 @@
 //! camera, pixel = illumination x reflectance, written straight into the caller's buffer (the
 //! loaned shared-memory slice).
 
+mod blur;
 mod effects;
 
-pub use effects::Effects;
+pub use effects::{Effects, mount_error};
 use harvey_msgs::Encoding;
 use harvey_world::{Pose2, World};
 
@@ -35,6 +36,10 @@ pub struct Renderer {
     height_px: u32,
     encoding: Encoding,
     focal_px: f64,
+    /// The camera's true yaw (left positive) and pitch (down positive) on its mount, radians:
+    /// what the robot's calibration does not know (`Camera::misalignment_sd_rad`).
+    yaw_rad: f64,
+    pitch_rad: f64,
     columns: Vec<Column>,
 }
 
@@ -42,7 +47,26 @@ impl Renderer {
     /// A renderer for `width_px x height_px`; the world's focal length scales with the width.
     pub fn new(world: &World, width_px: u32, height_px: u32, encoding: Encoding) -> Self {
         let focal_px = world.camera.focal_for(width_px);
-        Self { width_px, height_px, encoding, focal_px, columns: vec![Column::default(); width_px as usize] }
+        Self {
+            width_px,
+            height_px,
+            encoding,
+            focal_px,
+            yaw_rad: 0.0,
+            pitch_rad: 0.0,
+            columns: vec![Column::default(); width_px as usize],
+        }
+    }
+
+    /// The same renderer with the camera turned `yaw_rad` left and tilted `pitch_rad` down on
+    /// its mount (small angles: the pitch moves every row by the same angle).
+    pub fn misaligned(self, yaw_rad: f64, pitch_rad: f64) -> Self {
+        Self { yaw_rad, pitch_rad, ..self }
+    }
+
+    /// The mount's yaw and pitch, radians.
+    pub fn misalignment(&self) -> (f64, f64) {
+        (self.yaw_rad, self.pitch_rad)
     }
 
     pub fn frame_bytes(&self) -> usize {
@@ -71,15 +95,18 @@ impl Renderer {
             return Err(RenderError::NotFinite { pose });
         }
         let cx = f64::from(self.width_px) / 2.0;
+        let aimed = Pose2 { heading_rad: heading + self.yaw_rad, ..pose };
         for (u, col) in self.columns.iter_mut().enumerate() {
-            *col = Column::cast(world, pose, (cx - u as f64 - 0.5) / self.focal_px);
+            *col = Column::cast(world, aimed, (cx - u as f64 - 0.5) / self.focal_px);
         }
         let cam = &world.camera;
         let cy = f64::from(self.height_px) / 2.0;
         let bpp = self.encoding.bytes_per_pixel() as usize;
         let row_bytes = self.width_px as usize * bpp;
         for (v, row) in out.chunks_exact_mut(row_bytes).enumerate() {
-            let down = (v as f64 + 0.5 - cy) / self.focal_px; // image y of this row, down positive
+            // Image y of this row over the focal length, down positive, turned by the pitch.
+            let level = (v as f64 + 0.5 - cy) / self.focal_px;
+            let down = if self.pitch_rad == 0.0 { level } else { (level.atan() + self.pitch_rad).tan() };
             for (col, px) in self.columns.iter().zip(row.chunks_exact_mut(bpp)) {
                 let (reflectance, colour) = col.appearance(world, [x, y], down);
                 let lit = cam.illumination * reflectance;
@@ -186,6 +213,32 @@ mod tests {
         let f = w.camera.focal_px;
         let u = (320.0 - f * (1.0 / 2.45) - 0.5).round() as usize;
         assert_eq!(img[240 * 640 + u], lit(0.50), "column {u}");
+    }
+
+    #[test]
+    fn a_misaligned_mount_turns_and_tilts_the_view() {
+        let w = hallway();
+        let (mut a, mut b) = (vec![0u8; 640 * 480], vec![0u8; 640 * 480]);
+        let pose = Pose2::new(5.0, 0.0, 0.0);
+        Renderer::new(&w, 640, 480, Encoding::Mono8)
+            .misaligned(0.01, 0.0)
+            .render(&w, pose, &mut a)
+            .expect("renders");
+        Renderer::new(&w, 640, 480, Encoding::Mono8)
+            .render(&w, Pose2 { heading_rad: 0.01, ..pose }, &mut b)
+            .expect("renders");
+        assert_eq!(a, b, "a yawed mount sees what a turned robot sees");
+        // The end wall's foot (floor below, wall above) in the centre column, 11 m ahead: it sits
+        // f h / d = 60 px below the centre row; tilting down by 0.01 rad raises it f 0.01 = 5.5 px.
+        let foot =
+            |img: &[u8]| (240..480).find(|&v| img[v * 640 + 320] != img[240 * 640 + 320]).expect("a foot");
+        let level = foot(&b);
+        Renderer::new(&w, 640, 480, Encoding::Mono8)
+            .misaligned(0.0, 0.01)
+            .render(&w, Pose2 { heading_rad: 0.01, ..pose }, &mut a)
+            .expect("renders");
+        let tilted = foot(&a);
+        assert!((level as f64 - tilted as f64 - 5.54).abs() <= 1.0, "foot at {level}, tilted {tilted}");
     }
 
     #[test]

@@ -33,6 +33,10 @@ pub struct FlfParams {
     /// Keep only lines whose direction (0..180 degrees, image x to the right, y down) lies in
     /// this range; `None` keeps all.
     pub orientation_deg: Option<(f32, f32)>,
+    /// Adaptive thresholds: the gradient floors are raised to this many times the window's own
+    /// noise sigma (`noise::noise_sigma`; the mean-gradient floor too), so that a
+    /// noisy camera's speckle does not break the edge-support regions up. 0: fixed floors.
+    pub noise_factor: f32,
 }
 
 impl Default for FlfParams {
@@ -46,6 +50,8 @@ impl Default for FlfParams {
             min_mean_gradient: 12.0,
             max_dispersion: 2.0,
             orientation_deg: None,
+            // Noise alone passes 3.5 sigma in 0.2 % of the cells (a Rayleigh magnitude).
+            noise_factor: 3.5,
         }
     }
 }
@@ -82,11 +88,23 @@ impl Flf {
                 p.buckets
             )));
         }
-        self.build_lut(p);
         self.lines.clear();
         if w.width() < 2 || w.height() < 2 {
             return Ok(&self.lines);
         }
+        let adapted;
+        let p = if p.noise_factor > 0.0 {
+            let floor = p.noise_factor * crate::noise::noise_sigma(img, w);
+            adapted = FlfParams {
+                min_gradient: p.min_gradient.max(floor).round(),
+                min_mean_gradient: p.min_mean_gradient.max(floor),
+                ..*p
+            };
+            &adapted
+        } else {
+            p
+        };
+        self.build_lut(p);
         self.label(img, w, p);
         let (ww, wh) = (w.width() - 1, w.height() - 1);
         let partitions = if p.overlap { 2 } else { 1 };

@@ -11,6 +11,7 @@ pub mod hough;
 pub mod image;
 pub mod moravec;
 pub mod nc;
+pub mod noise;
 pub mod path;
 pub mod pyramid;
 pub mod regions;

@@ -51,6 +51,7 @@ pub(crate) fn check_bounds(w: &World) -> Result<(), OutOfRange> {
     check(&start.key("heading_deg"), w.start.heading_rad.to_degrees(), &ANGLE)?;
     check_robot(w)?;
     check_camera(w)?;
+    check_map_error(w)?;
     let floor = root("floor");
     check(&floor.key("tile_m"), w.floor.tile_m, &HEIGHT)?;
     check_all(&floor.key("reflectance"), &w.floor.reflectance, &FRACTION)?;
@@ -79,7 +80,15 @@ fn check_robot(w: &World) -> Result<(), OutOfRange> {
     check(&k.key("sonar_beam_width_deg"), r.sonar_beam_width_deg, &Range::open(0.0, 90.0, "deg"))?;
     check(&k.key("sonar_specular_limit_deg"), r.sonar_specular_limit_deg, &Range::above(0.0, 90.0, "deg"))?;
     // The Polaroid sensor reaches 35 ft; a ray cast longer than 1000 ft finds nothing new.
-    check(&k.key("sonar_max_range_ft"), r.sonar_max_range_ft, &Range::above(0.0, 1000.0, "ft"))
+    check(&k.key("sonar_max_range_ft"), r.sonar_max_range_ft, &Range::above(0.0, 1000.0, "ft"))?;
+    // Noise beyond 10 ft would make every reading meaningless; chances are fractions.
+    check(&k.key("sonar_range_sd_ft"), r.sonar_range_sd_ft, &Range::closed(0.0, 10.0, "ft"))?;
+    check(&k.key("sonar_dropout"), r.sonar_dropout, &FRACTION)?;
+    check(&k.key("sonar_crosstalk"), r.sonar_crosstalk, &FRACTION)?;
+    check(&k.key("sonar_multipath"), r.sonar_multipath, &FRACTION)?;
+    // An encoder coarser than a foot or 10 degrees per count could not drive a doorway.
+    check(&k.key("encoder_count_ft"), r.encoder_count_ft, &Range::closed(0.0, 1.0, "ft"))?;
+    check(&k.key("encoder_count_deg"), r.encoder_count_deg, &Range::closed(0.0, 10.0, "deg"))
 }
 
 fn check_camera(w: &World) -> Result<(), OutOfRange> {
@@ -92,7 +101,23 @@ fn check_camera(w: &World) -> Result<(), OutOfRange> {
     check(&k.key("illumination"), c.illumination, &Range::closed(0.0, 10_000.0, ""))?;
     // The corners get 1 - vignetting of the centre's light: at 1 they would be black.
     check(&k.key("vignetting"), c.vignetting, &Range::below(0.0, 1.0, ""))?;
-    check(&k.key("noise_sd"), c.noise_sd, &Range::closed(0.0, 1_000.0, "grey levels"))
+    check(&k.key("noise_sd"), c.noise_sd, &Range::closed(0.0, 1_000.0, "grey levels"))?;
+    // A swing of the whole light either way: at 1 the scene would go black once a period.
+    check(&k.key("illumination_drift"), c.illumination_drift, &Range::below(0.0, 1.0, ""))?;
+    check(&k.key("illumination_period_s"), c.illumination_period_s, &Range::above(0.0, 1e6, "s"))?;
+    // 000 §5.5 studies 0.001 and 0.010 rad; 0.2 rad (11 degrees) is a camera knocked off its mount.
+    check(&k.key("misalignment_sd_rad"), c.misalignment_sd_rad, &Range::closed(0.0, 0.2, "rad"))?;
+    check(&k.key("blur_px"), f64::from(c.blur_px), &Range::closed(0.0, 16.0, "px"))
+}
+
+fn check_map_error(w: &World) -> Result<(), OutOfRange> {
+    let (k, e) = (root("map_error"), &w.map_error);
+    // A map off by more than half a metre is another building.
+    check(&k.key("position_sd_m"), e.position_sd_m, &Range::closed(0.0, 0.5, "m"))?;
+    check(&k.key("reflectance_sd"), e.reflectance_sd, &Range::closed(0.0, 1.0, ""))?;
+    let (k, s) = (root("survey"), &w.survey);
+    check(&k.key("position_sd_m"), s.position_sd_m, &Range::closed(0.0, 0.5, "m"))?;
+    check(&k.key("calibration_sd_rad"), s.calibration_sd_rad, &Range::closed(0.0, 0.2, "rad"))
 }
 
 fn check_terrain(k: &KeyPath, t: &Terrain) -> Result<(), OutOfRange> {

@@ -2,6 +2,7 @@
 //! statistics, the robot's sonar and drive, and the camera; loaded from TOML and ray cast.
 //!
 
+mod as_built;
 mod bounds;
 mod bounds_topology;
 mod camera;
@@ -13,6 +14,7 @@ mod poles;
 mod raycast;
 pub mod topology;
 
+pub use as_built::{MapError, Survey};
 pub use camera::project_with;
 pub use check::Inconsistency;
 pub use load::{WorldError, load_str};

@@ -111,6 +111,26 @@ pub struct Robot {
     /// Beyond this angle between the beam and the wall's normal the echo reflects away.
     pub sonar_specular_limit_deg: f64,
     pub sonar_max_range_ft: f64,
+    /// Range noise of an echo, standard deviation in feet (seeded).
+    #[serde(default)]
+    pub sonar_range_sd_ft: f64,
+    /// Chance that a sensor hears nothing although an echo came back (seeded).
+    #[serde(default)]
+    pub sonar_dropout: f64,
+    /// Chance that a sensor hears the echo of another sensor of its bank, fired at the same time,
+    /// and reports that range when it is the shorter (001 §3: crosstalk).
+    #[serde(default)]
+    pub sonar_crosstalk: f64,
+    /// Chance that the echo comes back by way of a second wall: a range 20-100 % too long
+    /// (001 §3: multiple reflections).
+    #[serde(default)]
+    pub sonar_multipath: f64,
+    /// Shaft-encoder resolution of travel, feet per count (0: exact).
+    #[serde(default)]
+    pub encoder_count_ft: f64,
+    /// Shaft-encoder resolution of the steering, degrees per count (0: exact).
+    #[serde(default)]
+    pub encoder_count_deg: f64,
 }
 
 /// The pinhole camera on the robot, looking along its heading.
@@ -129,6 +149,24 @@ pub struct Camera {
     /// Sensor noise, standard deviation in grey levels (seeded per frame).
     #[serde(default)]
     pub noise_sd: f64,
+    /// The light's slow change over a run (clouds, lights): the illumination swings by this
+    /// fraction either way, sinusoidally over `illumination_period_s`, at a seeded phase.
+    #[serde(default)]
+    pub illumination_drift: f64,
+    #[serde(default = "default_illumination_period_s")]
+    pub illumination_period_s: f64,
+    /// The mount's misalignment that the robot's calibration does not know: the true yaw and
+    /// pitch of the camera are drawn per run from a normal of this standard deviation, radians
+    /// (000 §5.5 Fig. 10 studies 0.001 and 0.010 rad).
+    #[serde(default)]
+    pub misalignment_sd_rad: f64,
+    /// Optical blur: a box filter of this radius in pixels (0: sharp).
+    #[serde(default)]
+    pub blur_px: u32,
+}
+
+fn default_illumination_period_s() -> f64 {
+    120.0
 }
 
 /// A whole world.
@@ -157,6 +195,12 @@ pub struct World {
     /// Coded poles to put down at seeded places (`poles.rs`, 004 §5).
     #[serde(default)]
     pub poles: Option<crate::PoleField>,
+    /// How far the world as built differs from this file, the robot's map (`as_built.rs`).
+    #[serde(default)]
+    pub map_error: crate::MapError,
+    /// What the robot knows of its map's and camera's accuracy (`as_built.rs`).
+    #[serde(default)]
+    pub survey: crate::Survey,
     /// Moving things (`movers.rs`), added from a mission; their walls follow `static_walls`.
     #[serde(skip)]
     pub(crate) movers: Vec<crate::Mover>,

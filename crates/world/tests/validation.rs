@@ -59,10 +59,9 @@ fn nan_beam_widths_and_illumination_are_refused() {
     let (text, line) = edit(HALLWAY, "[camera]", "illumination = 220.0", "illumination = nan");
     let e = refused(&text);
     assert!(e.starts_with(&format!("w.toml:{line}: field `camera.illumination`: NaN")), "{e}");
-    let (text, line) =
-        edit(HALLWAY, "[camera]", "illumination = 220.0", "illumination = 220.0\nvignetting = 1.0");
+    let (text, line) = edit(HALLWAY, "[camera]", "vignetting = 0.2", "vignetting = 1.0");
     let e = refused(&text);
-    assert!(e.starts_with(&format!("w.toml:{}: field `camera.vignetting`", line + 1)), "{e}");
+    assert!(e.starts_with(&format!("w.toml:{line}: field `camera.vignetting`")), "{e}");
 }
 
 #[test]

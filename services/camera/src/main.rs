@@ -10,7 +10,7 @@ use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, FramePublisher, Pace, Step, Waiter, Wake};
 use harvey_msgs::{Encoding, FrameHeader, topics};
-use harvey_render::{Effects, Renderer, checksum};
+use harvey_render::{Effects, Renderer, checksum, mount_error};
 use harvey_world::{Pose2, World};
 
 #[derive(Parser)]
@@ -42,7 +42,8 @@ struct Args {
     rate_hz: f64,
     #[arg(long, default_value_t = 0)]
     frames: u64,
-    /// Seed of the sensor noise (the world's camera sets how much) and of the poles' places.
+    /// Seed of the sensor noise, the light's phase and the mount's misalignment (the world's
+    /// camera sets how much), of the map error and of the poles' places.
     #[arg(long, default_value_t = 1)]
     seed: u64,
     /// A launch file whose `[[mover]]` tables put moving things in the world.
@@ -72,7 +73,7 @@ impl Camera {
             header.height_px as usize,
             header.stride_bytes as usize / header.width_px as usize,
         );
-        self.effects.apply(w, h, bpp, self.seq, frame.pixels_mut());
+        self.effects.apply_at(w, h, bpp, self.seq, stamp_ns, frame.pixels_mut());
         tracing::debug!(seq = self.seq, checksum = checksum(frame.pixels_mut()), "frame");
         frame.send()?;
         Ok(())
@@ -121,7 +122,8 @@ fn main() -> anyhow::Result<()> {
         return play_folder(dir, &args);
     }
     let world_path = args.world.as_ref().context("--world or --images is required")?;
-    let mut world = World::load(world_path)?;
+    // The world as built, not as mapped: the robot's services keep the file (`[map_error]`).
+    let mut world = World::load(world_path)?.as_built(args.seed);
     world.place_poles(args.seed)?;
     if let Some(file) = &args.movers {
         world.add_movers(harvey_world::load_movers(file)?);
@@ -134,11 +136,14 @@ fn main() -> anyhow::Result<()> {
         width > 0 && height > 0 && width <= 8192 && height <= 8192,
         "image size {width}x{height} out of range"
     );
-    let renderer = Renderer::new(&world, width, height, encoding);
+    let (yaw, pitch) = mount_error(&world.camera, args.seed);
+    if yaw != 0.0 || pitch != 0.0 {
+        tracing::info!(yaw_rad = yaw, pitch_rad = pitch, "camera mount misaligned (unknown to the robot)");
+    }
+    let renderer = Renderer::new(&world, width, height, encoding).misaligned(yaw, pitch);
     let bus = Bus::join("camera")?;
     let publisher = bus.frame_publisher(topics::CAMERA_FRAME, renderer.frame_bytes())?;
-    let effects =
-        Effects { vignetting: world.camera.vignetting, noise_sd: world.camera.noise_sd, seed: args.seed };
+    let effects = Effects::from_camera(&world.camera, args.seed);
     let mut cam = Camera { world, renderer, effects, publisher, seq: 0 };
     let waiter = Waiter::new()?;
 

@@ -146,6 +146,9 @@ impl Site<'_> {
                     height_px: w.camera.height_px,
                     camera_height_m: w.camera.height_m,
                     tracking: sv.offset,
+                    calibrate: sv.calibrate_mount,
+                    gate_rad: sv.gate_deg.to_radians(),
+                    gate_range: sv.gate_range,
                 }))
             })
             .collect()

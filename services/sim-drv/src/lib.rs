@@ -27,11 +27,16 @@ pub struct TickOutput {
     pub reports: Vec<Report>,
 }
 
+/// Seeds the sensors' randomness apart from the motion's.
+const SENSOR_STREAM: u64 = 0x0073_6f6e_6172;
+
 /// The simulated vehicle.
 pub struct SimDrv {
     world: World,
     tick_ms: u64,
     rng: Rng,
+    /// The sensors' own randomness (sonar imperfections), apart from the motion's.
+    sensor_rng: Rng,
     time_ms: u64,
     truth: Pose2,
     encoders: Pose2,
@@ -51,6 +56,7 @@ impl SimDrv {
             world,
             tick_ms,
             rng,
+            sensor_rng: Rng::new(seed ^ SENSOR_STREAM),
             time_ms: 0,
             truth,
             encoders: truth,
@@ -155,7 +161,8 @@ impl SimDrv {
         let dt_s = self.tick_ms as f64 / 1000.0;
         if let Some(m) = &mut self.motion {
             let t = self.world.terrain_at(self.truth.x_m, self.truth.y_m);
-            let (truth, enc, finished) = motion::advance(m, t, self.truth, self.encoders, dt_s);
+            let counts = motion::Counts::of(&self.world.robot);
+            let (truth, enc, finished) = motion::advance(m, t, counts, self.truth, self.encoders, dt_s);
             self.truth = truth;
             self.encoders = enc;
             if finished {
@@ -164,7 +171,7 @@ impl SimDrv {
         }
         let bank = self.next_bank;
         self.next_bank = (bank + 1) % 3;
-        let ranges_tenths_ft = sonar::fire_bank(&self.world, self.truth, bank);
+        let ranges_tenths_ft = sonar::fire_bank(&self.world, self.truth, bank, &mut self.sensor_rng);
         let heading_deg = self.encoders.heading_rad.to_degrees().rem_euclid(360.0);
         let reports = vec![
             Report::Encoders {

@@ -49,7 +49,8 @@ fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
     anyhow::ensure!(args.tick_ms > 0 && args.speedup > 0.0, "--tick-ms and --speedup must be positive");
-    let mut world = harvey_world::World::load(&args.world)?;
+    // The world as built, not as mapped: the robot's services keep the file (`[map_error]`).
+    let mut world = harvey_world::World::load(&args.world)?.as_built(args.seed);
     if let Some(start) = args.start {
         world.start = start;
     }

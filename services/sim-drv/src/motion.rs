@@ -89,20 +89,49 @@ pub fn plan_turn(
     }
 }
 
+/// The shaft encoders' resolution: travel and steering per count (0: exact).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Counts {
+    pub m: f64,
+    pub rad: f64,
+}
+
+impl Counts {
+    /// From the world's `[robot] encoder_count_ft` and `encoder_count_deg`.
+    pub fn of(r: &harvey_world::Robot) -> Self {
+        Self { m: r.encoder_count_ft * FT, rad: r.encoder_count_deg.to_radians() }
+    }
+}
+
+/// `x` in whole counts of `count` (towards zero: a count registers once it is complete).
+fn counted(x: f64, count: f64) -> f64 {
+    if count > 0.0 { (x / count + 1e-9 * x.signum()).trunc() * count } else { x }
+}
+
 /// Advances a motion by `dt_s`; returns the new (truth, encoder) poses and whether it finished.
-pub fn advance(m: &mut Motion, t: &Terrain, truth: Pose2, enc: Pose2, dt_s: f64) -> (Pose2, Pose2, bool) {
+/// The encoders count the commanded motion in whole counts of `counts`.
+pub fn advance(
+    m: &mut Motion,
+    t: &Terrain,
+    counts: Counts,
+    truth: Pose2,
+    enc: Pose2,
+    dt_s: f64,
+) -> (Pose2, Pose2, bool) {
     match m {
         Motion::Move { truth0, enc0, true_m, true_dth, commanded_m, done, duration_s } => {
             *done = if *duration_s > 0.0 { (*done + dt_s / *duration_s).min(1.0) } else { 1.0 };
             let f = *done;
-            (truth0.arc(f * *true_m, f * *true_dth), enc0.arc(f * *commanded_m, 0.0), f >= 1.0)
+            let enc = enc0.arc(counted(f * *commanded_m, counts.m), 0.0);
+            (truth0.arc(f * *true_m, f * *true_dth), enc, f >= 1.0)
         }
         Motion::Turn { truth0, enc0, true_rad, skitter_m, commanded_rad, done, duration_s } => {
             *done = if *duration_s > 0.0 { (*done + dt_s / *duration_s).min(1.0) } else { 1.0 };
             let f = *done;
             let shifted = truth0.sideways(f * *skitter_m);
             let truth = Pose2 { heading_rad: truth0.heading_rad + f * *true_rad, ..shifted };
-            (truth, Pose2 { heading_rad: enc0.heading_rad + f * *commanded_rad, ..*enc0 }, f >= 1.0)
+            let turned = counted(f * *commanded_rad, counts.rad);
+            (truth, Pose2 { heading_rad: enc0.heading_rad + turned, ..*enc0 }, f >= 1.0)
         }
         Motion::Velocity { v_mps, w_radps, drift_rad_per_m } => {
             let s_true = *v_mps * (1.0 - t.translational_loss_ft_per_ft) * dt_s;
@@ -131,7 +160,8 @@ mod tests {
         let mut travelled_ft = Vec::new();
         for _ in 0..n {
             let mut m = plan_move(&tile(), &mut rng, 1.0, Pose2::default(), Pose2::default(), 20.0 * FT, 0.3);
-            let (truth, enc, finished) = advance(&mut m, &tile(), Pose2::default(), Pose2::default(), 1e6);
+            let (truth, enc, finished) =
+                advance(&mut m, &tile(), Counts::default(), Pose2::default(), Pose2::default(), 1e6);
             assert!(finished);
             assert!((enc.x_m - 20.0 * FT).abs() < 1e-9, "encoders report the commanded move");
             let d = truth.x_m.hypot(truth.y_m) / FT;
@@ -142,5 +172,20 @@ mod tests {
         // 20 ft at 4.2 % loss plus 0.0084 ft inertial loss; the arc's chord is a hair shorter.
         let expected = 20.0 - 20.0 * 0.042 - 0.0084;
         assert!((mean - expected).abs() < 0.01, "mean {mean} vs {expected}");
+    }
+
+    #[test]
+    fn the_encoders_count_whole_counts() {
+        let counts = Counts { m: 0.01 * FT, rad: 0.1f64.to_radians() };
+        let mut rng = Rng::new(2);
+        let p = Pose2::default();
+        let mut m = plan_move(&tile(), &mut rng, 1.0, p, p, 1.0, 0.3);
+        // 0.1 s of a 3.33 s move: 0.03 m = 0.0984 ft, which the encoders count as 0.09 ft.
+        let (_, enc, _) = advance(&mut m, &tile(), counts, p, p, 0.1);
+        assert!((enc.x_m - 0.09 * FT).abs() < 1e-9, "{}", enc.x_m / FT);
+        let mut t = plan_turn(&tile(), &mut rng, p, p, -1.0, 0.5);
+        let (_, enc, _) = advance(&mut t, &tile(), counts, p, p, 0.1);
+        // -0.05 rad = -2.865 deg: -2.8 deg counted.
+        assert!((enc.heading_rad.to_degrees() + 2.8).abs() < 1e-9, "{}", enc.heading_rad.to_degrees());
     }
 }

@@ -3,7 +3,8 @@
 //! grazing incidence (specular reflection).
 
 use harvey_drv_protocol::SONAR_NO_ECHO;
-use harvey_world::World;
+use harvey_geometry::Rng;
+use harvey_world::{Robot, World};
 
 use crate::motion::{FT, Pose2};
 
@@ -59,9 +60,44 @@ pub fn read_sensor(world: &World, truth: Pose2, i: usize) -> u16 {
     }
 }
 
-/// Fires bank `bank` (0..3): sensors `bank`, `bank + 3`, ... `bank + 21`.
-pub fn fire_bank(world: &World, truth: Pose2, bank: u8) -> [u16; 8] {
-    std::array::from_fn(|k| read_sensor(world, truth, bank as usize + 3 * k))
+/// Fires bank `bank` (0..3): sensors `bank`, `bank + 3`, ... `bank + 21`, with the ring's
+/// imperfections of the world's `[robot]` drawn from `rng` ([`imperfect`]).
+pub fn fire_bank(world: &World, truth: Pose2, bank: u8, rng: &mut Rng) -> [u16; 8] {
+    let clean = std::array::from_fn(|k| read_sensor(world, truth, bank as usize + 3 * k));
+    imperfect(&world.robot, clean, rng)
+}
+
+/// A bank's clean ranges as real transducers report them (001 §3): each sensor may hear the
+/// echo of another of its bank, fired at the same moment, and keep it when it comes first
+/// (crosstalk); an echo may come back by a second wall, 20-100 % long (multipath), or be lost
+/// (dropout); and every range has noise. The draws are the same whatever the ranges are, so
+/// one reading does not shift the randomness of the next.
+pub fn imperfect(r: &Robot, clean: [u16; 8], rng: &mut Rng) -> [u16; 8] {
+    let mut out = clean;
+    for k in 0..8 {
+        let (cross, other) = (rng.uniform(), (k + 1 + (rng.uniform() * 7.0) as usize) % 8);
+        let (multi, stretch) = (rng.uniform(), 1.2 + 0.8 * rng.uniform());
+        let (drop, noise) = (rng.uniform(), rng.normal(0.0, r.sonar_range_sd_ft));
+        if drop < r.sonar_dropout {
+            out[k] = SONAR_NO_ECHO;
+            continue;
+        }
+        let mut ft = (clean[k] != SONAR_NO_ECHO).then(|| f64::from(clean[k]) / 10.0);
+        if cross < r.sonar_crosstalk && clean[other] != SONAR_NO_ECHO {
+            let heard = f64::from(clean[other]) / 10.0;
+            ft = Some(ft.map_or(heard, |f| f.min(heard)));
+        }
+        if multi < r.sonar_multipath {
+            ft = ft.map(|f| f * stretch);
+        }
+        out[k] = match ft.map(|f| f + noise) {
+            Some(f) if f < r.sonar_max_range_ft => {
+                (f * 10.0).round().clamp(0.0, f64::from(SONAR_NO_ECHO - 1)) as u16
+            }
+            _ => SONAR_NO_ECHO,
+        };
+    }
+    out
 }
 
 #[cfg(test)]
@@ -86,6 +122,34 @@ mod tests {
                 (1.0 - w.robot.sonar_ring_radius_m * (std::f64::consts::FRAC_PI_2 + th).sin()) / FT * 10.0;
             assert_eq!(read_sensor(&w, turned, 6), d.round() as u16, "robot turned {th} rad");
         }
+    }
+
+    #[test]
+    fn imperfections_come_at_their_rates_and_a_perfect_ring_reads_clean() {
+        let mut r = hallway().robot;
+        (r.sonar_range_sd_ft, r.sonar_dropout, r.sonar_crosstalk, r.sonar_multipath) = (0.0, 0.0, 0.0, 0.0);
+        let clean = [30, 40, 50, 60, 70, 80, 90, SONAR_NO_ECHO];
+        let mut rng = Rng::new(5);
+        assert_eq!(imperfect(&r, clean, &mut rng), clean, "no imperfection asked: exact");
+        r.sonar_dropout = 0.1;
+        let n = 4000;
+        let lost: usize = (0..n)
+            .map(|_| imperfect(&r, clean, &mut rng)[..7].iter().filter(|&&v| v == SONAR_NO_ECHO).count())
+            .sum();
+        let rate = lost as f64 / (7 * n) as f64;
+        assert!((rate - 0.1).abs() < 0.01, "dropout rate {rate}");
+        r.sonar_dropout = 0.0;
+        r.sonar_crosstalk = 1.0;
+        // Every sensor hears some other of its bank first when that one is nearer: never longer.
+        let heard = imperfect(&r, clean, &mut rng);
+        assert!(heard.iter().zip(clean).all(|(&h, c)| h <= c), "{heard:?}");
+        assert_ne!(heard[7], SONAR_NO_ECHO, "a silent sensor hears its neighbour's echo");
+        r.sonar_crosstalk = 0.0;
+        r.sonar_range_sd_ft = 0.2;
+        let errs: Vec<f64> =
+            (0..n).map(|_| f64::from(imperfect(&r, clean, &mut rng)[3]) / 10.0 - 6.0).collect();
+        let sd = (errs.iter().map(|e| e * e).sum::<f64>() / n as f64).sqrt();
+        assert!((sd - 0.2).abs() < 0.02, "range noise {sd} ft");
     }
 
     #[test]

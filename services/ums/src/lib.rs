@@ -5,6 +5,7 @@
 //! fixes (000 §5.6) shrink it to a small region, and the map reports "lost" when it grows too
 //! large or predicted landmarks go missing.
 
+mod consensus;
 mod error;
 pub mod expecter;
 mod fix;
@@ -156,11 +157,26 @@ impl Ums {
         while self.history.front().is_some_and(|(t, ..)| t + self.config.history_ns < o.header.stamp_ns) {
             self.history.pop_front();
         }
-        let due: Vec<LandmarkSighting> =
+        let mut due: Vec<LandmarkSighting> =
             self.pending.iter().copied().filter(|s| s.header.stamp_ns <= o.header.stamp_ns).collect();
+        // Frame by frame (stable: a frame's sightings keep their order).
+        due.sort_by_key(|s| s.header.stamp_ns);
         self.pending.retain(|s| s.header.stamp_ns > o.header.stamp_ns);
-        let rejected: Vec<Output> =
-            due.iter().filter_map(|s| self.apply_sighting(s).err()).map(Output::Rejected).collect();
+        let mut rejected: Vec<Output> = Vec::new();
+        for frame in due.chunk_by(|a, b| a.header.stamp_ns == b.header.stamp_ns) {
+            let blunders = consensus::outliers(&self.world, &self.map, frame, self.config.sigmas);
+            for (i, s) in frame.iter().enumerate() {
+                let outcome = if blunders.contains(&i)
+                    || consensus::implausible(&self.world, &self.map, s, self.config.sigmas)
+                {
+                    let landmark = self.world.landmarks[s.landmark_index as usize].name.clone();
+                    Err(SightingError::Rejected { landmark, why: reduction::Rejection::Disagrees })
+                } else {
+                    self.apply_sighting(s)
+                };
+                rejected.extend(outcome.err().map(Output::Rejected));
+            }
+        }
         let mut out = vec![Output::Map(Box::new(self.publishable(o.header.stamp_ns)))];
         for mut e in self.expectations(o.header.stamp_ns) {
             self.expectation_seq += 1;
@@ -217,7 +233,7 @@ impl Ums {
         let known = Known {
             at: [l.position_m[0], l.position_m[1]],
             to: l.to_m.map(|t| [t[0], t[1]]),
-            position_sd_m: l.position_sd_m,
+            position_sd_m: self.world.landmark_sd_m(l),
         };
         let (sigmas, name, stamp_ns) = (self.config.sigmas, l.name.clone(), s.header.stamp_ns);
         self.rewrite_at(

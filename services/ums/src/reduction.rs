@@ -41,6 +41,9 @@ pub enum Rejection {
     NoPosition,
     #[error("no heading in the wedge is consistent with the sighting")]
     NoHeading,
+    /// `consensus.rs`: the frame's other sightings imply another heading.
+    #[error("the other landmarks seen in the same frame disagree with it: a false match")]
+    Disagrees,
 }
 
 /// Keeps the side of the line through `o` along `d` to its left, widened by `margin`.

@@ -92,7 +92,8 @@ fn main() -> anyhow::Result<()> {
     let mut dispatcher = Dispatcher::new(world.clone());
 
     let mut edges = VerticalEdges::new(args.band_half_rows, args.edge_threshold);
-    let mut lines = LineLandmarks::new(world.camera.focal_px, args.edge_threshold);
+    let mut lines = LineLandmarks::new(world.camera.focal_px, args.edge_threshold)
+        .with_calibration_sd(world.survey.calibration_sd_rad);
     let mut wanted: BTreeMap<u32, Expectation> = BTreeMap::new();
     let max_age_ns = args.expectation_max_age_ms * 1_000_000;
     let (mut processed, mut found) = (0u64, 0u64);

@@ -19,7 +19,7 @@ fn frame(w: &World, pose: Pose2, seed: u64) -> Vec<u8> {
     let mut r = Renderer::new(w, 640, 480, Encoding::Mono8);
     let mut px = vec![0u8; r.frame_bytes()];
     r.render(w, pose, &mut px).expect("renders");
-    Effects { vignetting: 0.3, noise_sd: 3.0, seed }.apply(640, 480, 1, seed, &mut px);
+    Effects::noisy(0.3, 3.0, seed).apply(640, 480, 1, seed, &mut px);
     px
 }
 

@@ -37,8 +37,8 @@ fn overrides_replace_world_fields_and_keep_the_rest() {
 
 #[test]
 fn an_unknown_key_is_named_with_its_file_and_line() {
-    let e = refusal("# blur comes later\n[camera]\nnoise_sd = 2\nblur_px = 1.5\n");
-    assert!(e.starts_with("c/my.toml:4: key `camera.blur_px`"), "{e}");
+    let e = refusal("# no fisheye model\n[camera]\nnoise_sd = 2\nfisheye = 1.5\n");
+    assert!(e.starts_with("c/my.toml:4: key `camera.fisheye`"), "{e}");
     let e = refusal("[camra]\nnoise_sd = 2\n");
     assert!(e.starts_with("c/my.toml:1: key `camra`"), "{e}");
 }

@@ -17,14 +17,24 @@ pub enum Figure {
     FinalError,
     /// Poles visited (004 §5): more is better.
     PolesVisited,
+    /// 000 §5.6 Table 1: the worst pose fix's distance from the truth, inches.
+    FixError,
 }
 
 impl Figure {
     /// The figure of a launch file (`launch`) whose world (`world`) is given.
     pub fn for_mission(launch: &toml::Table, world: &toml::Table) -> Figure {
-        let servoed = launch.get("mission").and_then(|m| m.get("servo")).is_some();
+        let mission = launch.get("mission");
+        let servoed = mission.and_then(|m| m.get("servo")).is_some();
+        // A mission of pose fixes alone (refine steps, nothing driven): judged by its fixes.
+        let steps = mission.and_then(|m| m.get("step")).and_then(|s| s.as_array());
+        let fixes_only = mission.and_then(|m| m.get("refine")).is_some()
+            && mission.and_then(|m| m.get("ptrans")).is_none()
+            && steps.is_some_and(|s| !s.is_empty() && s.iter().all(|st| st.get("move_m").is_none()));
         if world.contains_key("poles") {
             Figure::PolesVisited
+        } else if fixes_only {
+            Figure::FixError
         } else if servoed {
             Figure::LineOffset
         } else {
@@ -38,6 +48,7 @@ impl Figure {
             Figure::LineOffset => "offset from the line (in)",
             Figure::FinalError => "final error (in)",
             Figure::PolesVisited => "poles visited",
+            Figure::FixError => "worst pose fix error (in)",
         }
     }
 
@@ -51,6 +62,7 @@ impl Figure {
             Figure::LineOffset => f.line_offset_m.map(|m| m / INCH_M),
             Figure::FinalError => f.final_error_m.map(|m| m / INCH_M),
             Figure::PolesVisited => f.poles.map(|(n, _)| n as f64),
+            Figure::FixError => f.fix_error_m.map(|m| m / INCH_M),
         }
     }
 }

@@ -38,6 +38,8 @@ pub struct Docking {
     target: Option<[f64; 3]>,
     /// Where the last Hough was tried.
     hough_at: Option<[f64; 2]>,
+    /// Going back to the approach zone's entry on the axis (out of the zone in q0), until there.
+    retreating: bool,
     /// Whether it docked, once the acceptor has accepted.
     pub done: Option<bool>,
     /// Odometry now, and the last fix from the dock.
@@ -71,6 +73,7 @@ impl Docking {
             light_rad: None,
             target: None,
             hough_at: None,
+            retreating: false,
             done: None,
             belief: Belief::default(),
             target_heading: 0.0,
@@ -132,7 +135,11 @@ impl Docking {
                 heading_deg = p.heading_rad.to_degrees(),
                 "pose from the dock"
             );
+            // Keep the tracked target's prediction in odometry's terms: the fix moves the belief,
+            // not the robot, so it must not move where the target is looked for.
+            let before = self.believed().heading_rad;
             self.belief.fix(p);
+            self.target_heading += wrap(self.believed().heading_rad - before);
         }
         match (self.perception(), item) {
             // A fix asked for while tracking: nothing more to it.
@@ -140,6 +147,9 @@ impl Docking {
             ("phototropic", Some(v)) if v[3] >= self.g.light_min_grey => {
                 self.light_rad = Some(at.heading_rad + ((self.centre_px[0] - v[0]) / self.focal_px).atan());
             }
+            // A lamp not seen now is no direction to go in: a bearing from elsewhere leads past the
+            // dock once the robot has moved.
+            ("phototropic", _) => self.light_rad = None,
             ("hough-dock", Some(v)) => {
                 // The target sits above the frame's centre, at the same distance.
                 let px_per_m = v[3] / (self.g.frame_width_m / 2.0);
@@ -243,19 +253,49 @@ impl Docking {
     fn phototropic(&mut self, at: Pose2, d: f64, now: u64, parts: &mut [V2; 5]) -> Option<VisionRequest> {
         let moved =
             self.hough_at.is_none_or(|p| (p[0] - at.x_m).hypot(p[1] - at.y_m) >= self.g.retry_after_m);
-        if d <= self.g.hough_range_m && moved {
+        let here = V2::new(at.x_m, at.y_m);
+        let dock = V2::new(self.g.dock_m[0], self.g.dock_m[1]);
+        let to_dock = dock.minus(here);
+        // In view: inside the camera's half field of view, less 5 degrees for the dock's own width.
+        let half_fov = (self.centre_px[0] / self.focal_px).atan() - 5f64.to_radians();
+        let in_view = wrap(to_dock.y.atan2(to_dock.x) - at.heading_rad).abs() <= half_fov;
+        let n = self.g.dock_facing_deg.to_radians();
+        let n = V2::new(n.cos(), n.sin());
+        let lateral = (to_dock.x * n.y - to_dock.y * n.x).abs();
+        // In the approach zone: on the axis's cone, and far enough out that the whole frame, its
+        // foot included, fits the image (`fix_beyond_m`): nearer, the Hough cannot see the dock.
+        let in_zone = d >= self.g.fix_beyond_m && lateral <= d * self.g.approach_cone_deg.to_radians().tan();
+        let approach = dock.plus(n.scale(self.g.hough_range_m - 0.5 * self.g.hough_range_sd_m));
+        // Latched, so that a robot on the zone's edge does not turn back and forth across it.
+        if !in_zone {
+            self.retreating = true;
+        } else if self.retreating && approach.minus(here).norm() < self.g.retry_after_m {
+            // Back at the zone's entry: a new view, so the Hough may be tried here again.
+            self.retreating = false;
+            self.hough_at = None;
+        }
+        if d <= self.g.hough_range_m && moved && in_view && in_zone && !self.retreating {
             self.trigger(Trigger::Terminal);
             self.seq.forget();
             return None;
         }
         let request = (!self.seq.waiting())
             .then(|| self.seq.request(now, VisionAlgorithm::Phototropic, [0.0; 4], [0.0; 8]));
-        let here = V2::new(at.x_m, at.y_m);
         let goal = match self.light_rad {
+            // Off the approach zone (beside the dock, past it): back to the axis first (002 §5.2:
+            // when tracking fails, go back to where discovery works).
+            _ if self.retreating => approach,
             Some(a) => here.plus(V2::new(a.cos(), a.sin()).scale(5.0)),
-            None => V2::new(self.g.dock_m[0], self.g.dock_m[1]),
+            None => dock,
         };
-        parts[0] = move_to_goal(here, goal, self.g.ballistic_mps);
+        // Within Hough range in the zone but not facing the dock: turn to it on the spot first,
+        // rather than drive on past the range where the frame fits the image.
+        let speed = if d <= self.g.hough_range_m && in_zone && !in_view && !self.retreating {
+            0.01
+        } else {
+            self.g.ballistic_mps
+        };
+        parts[0] = move_to_goal(here, goal, speed);
         if let Some(ring) = &self.ring {
             parts[1] = drive::avoid_echoes(ring, at, self.sensor_ring_m, &self.drive);
         }

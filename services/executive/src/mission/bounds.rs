@@ -107,6 +107,8 @@ fn check_step(k: &KeyPath, s: &Step) -> Result<(), OutOfRange> {
 fn check_servo(k: &KeyPath, s: &Servo) -> Result<(), OutOfRange> {
     check(&k.key("aim_m"), s.aim_m, &LENGTH)?;
     check(&k.key("misalignment_deg"), s.misalignment_deg, &MISALIGNMENT)?;
+    check(&k.key("gate_deg"), s.gate_deg, &Range::above(0.0, 90.0, "deg"))?;
+    check(&k.key("gate_range"), s.gate_range, &Range::above(0.0, 10.0, ""))?;
     check_int(&k.key("template_px"), s.template_px, TEMPLATE_MIN_PX, TEMPLATE_MAX_PX, "px")?;
     check(&k.key("min_score"), s.min_score, &SCORE)
 }

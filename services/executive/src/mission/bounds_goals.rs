@@ -67,6 +67,7 @@ pub(crate) fn check_docking(k: &KeyPath, d: &DockingGoal) -> Result<(), OutOfRan
     check(&k.key("retry_after_m"), d.retry_after_m, &LENGTH)?;
     check(&k.key("lead_m"), d.lead_m, &LENGTH)?;
     check(&k.key("keep_in_view_deg"), d.keep_in_view_deg, &HALF_TURN)?;
+    check(&k.key("approach_cone_deg"), d.approach_cone_deg, &Range::above(0.0, 90.0, "deg"))?;
     check(&k.key("close_area_px"), d.close_area_px, &AREA_PX)?;
     check_int(&k.key("fix_every_ticks"), d.fix_every_ticks, 0, MAX_TICKS, "ticks")?;
     check(&k.key("fix_beyond_m"), d.fix_beyond_m, &LENGTH_OR_ZERO)?;

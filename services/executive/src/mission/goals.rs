@@ -66,6 +66,12 @@ pub struct DockingGoal {
     /// Controlled motion keeps within this of the target's bearing (degrees), so that the
     /// target stays in the image.
     pub keep_in_view_deg: f64,
+    /// The approach zone (004 §4.2): the cone of this half-angle round the dock's axis. A robot
+    /// out of it in q0 (beside the dock, or past it) goes back to the axis,
+    /// `hough_range_m - hough_range_sd_m / 2` out; the Hough is tried only inside it, with the dock
+    /// believed in the camera's field of view.
+    #[serde(default = "default_approach_cone_deg")]
+    pub approach_cone_deg: f64,
     pub close_area_px: f64,
     /// While tracking, every this many ticks a fix from the Hough's frame, while the robot is
     /// further than `fix_beyond_m` from the face (nearer, the frame leaves the image).
@@ -205,4 +211,8 @@ pub(crate) fn check_poles(p: &PolesGoal) -> Result<(), &'static str> {
         return Err("count at least 1, enough at most count, lost_m and near_m beyond park_m");
     }
     Ok(())
+}
+
+fn default_approach_cone_deg() -> f64 {
+    30.0
 }

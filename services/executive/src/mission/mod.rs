@@ -65,6 +65,17 @@ pub struct Servo {
     /// The camera's yaw from the direction of motion, as calibrated (degrees, left positive).
     #[serde(default)]
     pub misalignment_deg: f64,
+    /// Measure the mount's yaw and pitch at the start of each servoed leg, from the landmark
+    /// seen where the robot stands on the line (the robot's calibration is never exact).
+    #[serde(default)]
+    pub calibrate_mount: bool,
+    /// A sighting implying a heading error over `gate_deg` (default 3: 002 Table 3's drift is
+    /// 0.27 deg/ft, half a degree an increment), or a distance off by more than the fraction
+    /// `gate_range` (default 0.1: the loss is 4 % per foot), is refused as a false match.
+    #[serde(default = "default_gate_deg")]
+    pub gate_deg: f64,
+    #[serde(default = "default_gate_range")]
+    pub gate_range: f64,
     /// Side of the appearance template (pixels) and least correlation score of a sighting.
     pub template_px: u32,
     pub min_score: f64,
@@ -72,6 +83,14 @@ pub struct Servo {
     /// leg's increments).
     #[serde(default)]
     pub offset: crate::script::leg::Tracking,
+}
+
+fn default_gate_deg() -> f64 {
+    3.0
+}
+
+fn default_gate_range() -> f64 {
+    0.1
 }
 
 /// The `[mission]` table of a launch file.

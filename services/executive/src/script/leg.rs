@@ -34,6 +34,15 @@ pub struct ServoSetup {
     /// it is seen in gives its distance.
     pub camera_height_m: f64,
     pub tracking: Tracking,
+    /// Measure the camera mount's yaw and pitch before the first increment, from the landmark
+    /// seen at the leg's start, where the robot stands on the line heading along it (a
+    /// boresight check: the robot does not know its mount exactly).
+    pub calibrate: bool,
+    /// A sighting implying a heading error beyond `gate_rad`, or a distance off the expected by
+    /// more than the fraction `gate_range`, is a false match: taken as a miss (002 §5.2: a
+    /// tracked landmark must be where it can be).
+    pub gate_rad: f64,
+    pub gate_range: f64,
 }
 
 /// What the leg wants done next.
@@ -48,6 +57,8 @@ pub enum LegStep {
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Phase {
+    /// Looking at the landmark from the start, to measure the mount.
+    Calibrating,
     Moving,
     Looking,
     Turning,
@@ -66,8 +77,10 @@ pub struct Leg {
     phase: Phase,
     /// Heading errors and corrections so far (radians).
     pub corrections: Vec<(f64, f64)>,
-    /// Looks that did not find the landmark.
+    /// Looks that did not find the landmark (refused false matches included).
     pub misses: u32,
+    /// Sightings refused as false matches.
+    pub refused: u32,
     tracking: Tracking,
     /// Estimated offset from the line (m, left positive) and heading relative to it (radians).
     pub offset_m: f64,
@@ -75,6 +88,9 @@ pub struct Leg {
     /// How far the robot is behind where its increments should have put it (m): measured from
     /// the landmark's distance (translational loss, 002 Table 3).
     pub shortfall_m: f64,
+    /// The camera mount's yaw (left positive) and pitch (down positive), radians: as
+    /// configured, or as measured at the start.
+    pub mount_rad: (f64, f64),
 }
 
 impl Leg {
@@ -88,10 +104,12 @@ impl Leg {
             phase: Phase::Moving,
             corrections: Vec::new(),
             misses: 0,
+            refused: 0,
             tracking: servo.map_or(Tracking::Whole, |s| s.tracking),
             offset_m: 0.0,
             heading_rad: 0.0,
             shortfall_m: 0.0,
+            mount_rad: (servo.map_or(0.0, |s| s.params.misalignment_rad), 0.0),
         }
     }
 
@@ -117,6 +135,10 @@ impl Leg {
 
     /// The first step.
     pub fn start(&mut self) -> LegStep {
+        if self.servo.is_some_and(|s| s.calibrate) {
+            self.phase = Phase::Calibrating;
+            return LegStep::Look(self.line);
+        }
         self.phase = Phase::Moving;
         self.done = 1;
         LegStep::Move(self.increment(0))
@@ -136,6 +158,16 @@ impl Leg {
     /// The look's outcome: the landmark's image position `[u, v]` (pixels), or `None` when it
     /// was not found.
     pub fn on_seen(&mut self, seen: Option<[f64; 2]>) -> LegStep {
+        if self.phase == Phase::Calibrating {
+            if let (Some(s), Some(uv)) = (self.servo, seen) {
+                self.mount_rad = measure_mount(&s, self.line, uv);
+            } else {
+                self.misses += 1;
+            }
+            self.phase = Phase::Moving;
+            self.done = 1;
+            return LegStep::Move(self.increment(0));
+        }
         let (Some(s), Some([u, v])) = (self.servo, seen) else {
             self.misses += u32::from(seen.is_none());
             return self.next_move();
@@ -147,29 +179,40 @@ impl Leg {
         let mut landmark = [dx * c + dy * sn, -dx * sn + dy * c];
         // Its distance from the row it is seen in, where it stands well above or below the camera.
         let (dz, rise) = (s.point[2] - s.camera_height_m, f64::from(s.height_px) / 2.0 - v);
+        // The row as a level camera would have seen it.
+        let rise = s.params.focal_px * ((rise / s.params.focal_px).atan() - self.mount_rad.1).tan();
+        let params = ServoParams { misalignment_rad: self.mount_rad.0, ..s.params };
+        let x_left = f64::from(s.width_px) / 2.0 - u;
+        let bearing_error =
+            landmark[1].atan2(landmark[0]) - ((x_left / params.focal_px).atan() + params.misalignment_rad);
+        if bearing_error.abs() > s.gate_rad + self.offset_m.abs() / landmark[0].max(1.0) {
+            return self.false_match(bearing_error, None);
+        }
         if dz.abs() > 0.2 && rise * dz > 0.0 && rise.abs() > 2.0 {
-            let measured = dz * s.params.focal_px / rise;
+            let measured = dz * params.focal_px / rise;
+            if (measured - landmark[0]).abs() > s.gate_range * landmark[0] {
+                return self.false_match(bearing_error, Some(measured - landmark[0]));
+            }
             self.shortfall_m -= landmark[0] - measured;
             landmark[0] = measured;
         }
-        let x_left = f64::from(s.width_px) / 2.0 - u;
         let m = self.increment(self.done - 1);
         let (h, turn) = match self.tracking {
             // 000 §5.5 as written: the increment started on the line.
             Tracking::Increment => {
-                let h = heading_error(landmark, x_left, m, &s.params);
-                (h, correction(h, m, &s.params))
+                let h = heading_error(landmark, x_left, m, &params);
+                (h, correction(h, m, &params))
             }
             // The offset carried over from earlier increments too: the increment ran at the
             // mean of its start heading (the last one corrected) and its end heading.
             Tracking::Whole => {
-                let mut h = heading_error_off_line(landmark, x_left, self.offset_m, &s.params);
+                let mut h = heading_error_off_line(landmark, x_left, self.offset_m, &params);
                 for _ in 0..2 {
                     let off = self.offset_m + m * ((self.heading_rad + h) / 2.0).sin();
-                    h = heading_error_off_line(landmark, x_left, off, &s.params);
+                    h = heading_error_off_line(landmark, x_left, off, &params);
                 }
                 self.offset_m += m * ((self.heading_rad + h) / 2.0).sin();
-                (h, correction_off_line(h, self.offset_m, &s.params))
+                (h, correction_off_line(h, self.offset_m, &params))
             }
         };
         self.heading_rad = h + turn;
@@ -181,6 +224,18 @@ impl Leg {
         LegStep::Turn(turn)
     }
 
+    /// A sighting no believable pose explains: counted as a miss, no correction.
+    fn false_match(&mut self, bearing_error: f64, range_error_m: Option<f64>) -> LegStep {
+        tracing::info!(
+            bearing_error_deg = bearing_error.to_degrees(),
+            range_error_m,
+            "servo sighting refused as a false match"
+        );
+        self.misses += 1;
+        self.refused += 1;
+        self.next_move()
+    }
+
     fn next_move(&mut self) -> LegStep {
         if self.done >= self.increments() {
             return LegStep::Done;
@@ -189,6 +244,20 @@ impl Leg {
         self.done += 1;
         LegStep::Move(self.increment(self.done - 1))
     }
+}
+
+/// The mount's (yaw, pitch) from the landmark seen at image `[u, v]` by a robot standing at
+/// `at` on the line, heading along it: the difference between where the point should appear to a
+/// true camera and where it does.
+fn measure_mount(s: &ServoSetup, at: Pose2, [u, v]: [f64; 2]) -> (f64, f64) {
+    let f = s.params.focal_px;
+    let (c, sn) = (at.heading_rad.cos(), at.heading_rad.sin());
+    let (dx, dy) = (s.point[0] - at.x_m, s.point[1] - at.y_m);
+    let (ahead, left) = (dx * c + dy * sn, -dx * sn + dy * c);
+    let (x_left, rise) = (f64::from(s.width_px) / 2.0 - u, f64::from(s.height_px) / 2.0 - v);
+    let yaw = left.atan2(ahead) - (x_left / f).atan();
+    let pitch = (rise / f).atan() - (s.point[2] - s.camera_height_m).atan2(ahead);
+    (yaw, pitch)
 }
 
 /// The tests' servoing set-up: a landmark 16 m down the line, 0.2 m to its left, at the
@@ -204,6 +273,9 @@ pub(crate) fn test_setup() -> ServoSetup {
         height_px: 480,
         camera_height_m: 2.3,
         tracking: Tracking::Increment,
+        calibrate: false,
+        gate_rad: 3f64.to_radians(),
+        gate_range: 0.1,
     }
 }
 
@@ -248,5 +320,38 @@ mod tests {
         leg.on_done();
         assert_eq!(leg.on_seen(None), LegStep::Move(0.6));
         assert_eq!(leg.misses, 1);
+        // A match 60 px off (6 degrees: no 0.6 m increment turns that far) is refused.
+        let u = 320.0 - 554.0 * (0.2f64 / 15.4) + 60.0;
+        let LegStep::Look(_) = leg.on_done() else { panic!("looks") };
+        assert_eq!(leg.on_seen(Some([u, 240.0])), LegStep::Done, "refused: no turn");
+        assert_eq!((leg.misses, leg.refused, leg.corrections.len()), (2, 1, 0));
+    }
+
+    #[test]
+    fn a_calibrating_leg_measures_the_mount_first_and_then_sees_through_it() {
+        let s = ServoSetup { calibrate: true, point: [16.0, 0.2, 3.3], ..setup() };
+        let (yaw, pitch) = (0.01, -0.004);
+        // Where a camera yawed left by `yaw` and tilted down by `pitch` sees the point from
+        // `ahead` m before it on the line.
+        let seen = |ahead: f64| {
+            let u = 320.0 - 554.0 * ((0.2f64).atan2(ahead) - yaw).tan();
+            let v = 240.0 - 554.0 * ((1.0f64).atan2(ahead) + pitch).tan();
+            [u, v]
+        };
+        let mut leg = Leg::new(Pose2::default(), 1.2, 0.6, Some(s));
+        assert_eq!(leg.start(), LegStep::Look(Pose2::default()), "looks before moving");
+        assert_eq!(leg.on_seen(Some(seen(16.0))), LegStep::Move(0.6));
+        assert!((leg.mount_rad.0 - yaw).abs() < 1e-12 && (leg.mount_rad.1 - pitch).abs() < 1e-12);
+        let LegStep::Look(_) = leg.on_done() else { panic!("looks") };
+        // On the line after the increment, seen through the same mount: nothing to correct, and
+        // the distance from the row is right (no shortfall).
+        let LegStep::Turn(t) = leg.on_seen(Some(seen(15.4))) else { panic!("turns") };
+        assert!(t.abs() < 1e-9 && leg.shortfall_m.abs() < 1e-9, "{t} {}", leg.shortfall_m);
+        // Unmeasured, the same sightings steer off the line.
+        let mut blind = Leg::new(Pose2::default(), 1.2, 0.6, Some(setup()));
+        blind.start();
+        blind.on_done();
+        let LegStep::Turn(t) = blind.on_seen(Some(seen(15.4))) else { panic!("turns") };
+        assert!(t.abs() > 0.01, "{t}");
     }
 }

@@ -104,6 +104,9 @@ fn servoed() -> Executive {
     let table = Servo {
         aim_m: 1.2,
         misalignment_deg: 0.0,
+        calibrate_mount: false,
+        gate_deg: 3.0,
+        gate_range: 0.1,
         template_px: 16,
         min_score: 0.9,
         offset: Tracking::Increment,
