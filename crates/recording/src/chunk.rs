@@ -1,6 +1,6 @@
 //! Opening a chunk: its records decompressed within limits and checked against the chunk's CRC
 //! before any of them is parsed or handed on. A chunk may claim at most what its compressed bytes
-//! could decompress to (zstd's largest ratio) and never more than [`MAX_CHUNK_BYTES`], so a
+//! could decompress to (the codec's largest ratio) and never more than [`MAX_CHUNK_BYTES`], so a
 //! flipped bit in a size is an error, not an allocation; the output buffer grows with what is
 //! actually decompressed, never with what is claimed.
 
@@ -19,6 +19,10 @@ pub const MAX_CHUNK_BYTES: u64 = 1 << 30;
 /// zstd's largest ratio: a 128 KiB block from 4 bytes (an RLE block's header and byte).
 const MAX_ZSTD_RATIO: u64 = 32 * 1024;
 
+/// Above LZ4's largest ratio: a match of any length costs at least one more byte per 255 it
+/// covers.
+const MAX_LZ4_RATIO: u64 = 300;
+
 /// What the output buffer starts at, before it grows with what is decompressed.
 const FIRST_RESERVE: u64 = 8 << 20;
 
@@ -31,11 +35,12 @@ pub(crate) fn open<'a>(header: &ChunkHeader, data: &'a [u8]) -> Result<Opened<'a
         "" if claims == compressed => Cow::Borrowed(data),
         "" => return Err(Damage::ChunkSize { claims, got: compressed }),
         "zstd" => {
-            let cap = MAX_CHUNK_BYTES.min(compressed.saturating_mul(MAX_ZSTD_RATIO));
-            if claims > cap {
-                return Err(Damage::ChunkTooLarge { claims, compressed, cap });
-            }
+            within(claims, compressed, MAX_ZSTD_RATIO)?;
             Cow::Owned(guarded(|| unzstd(data, claims), Damage::Decompress)?)
+        }
+        "lz4" => {
+            within(claims, compressed, MAX_LZ4_RATIO)?;
+            Cow::Owned(guarded(|| unlz4(data, claims), Damage::Decompress)?)
         }
         other => return Err(Damage::Compression(other.to_owned())),
     };
@@ -61,11 +66,31 @@ impl Opened<'_> {
     }
 }
 
-/// Decompresses `data`, which must come to exactly `claims` bytes (at most `claims + 1` are
-/// decompressed, to tell).
+/// Refuses a claimed size that `compressed` bytes of a codec of `max_ratio` cannot reach.
+fn within(claims: u64, compressed: u64, max_ratio: u64) -> Result<(), Damage> {
+    let cap = MAX_CHUNK_BYTES.min(compressed.saturating_mul(max_ratio));
+    if claims > cap {
+        return Err(Damage::ChunkTooLarge { claims, compressed, cap });
+    }
+    Ok(())
+}
+
+/// Decompresses zstd `data`, which must come to exactly `claims` bytes.
 fn unzstd(data: &[u8], claims: u64) -> Result<Vec<u8>, Damage> {
     let decoder =
         zstd::stream::read::Decoder::with_buffer(data).map_err(|e| Damage::Decompress(e.to_string()))?;
+    read_exactly(decoder, claims)
+}
+
+/// Decompresses an LZ4 frame, which must come to exactly `claims` bytes.
+fn unlz4(data: &[u8], claims: u64) -> Result<Vec<u8>, Damage> {
+    let decoder = lz4::Decoder::new(data).map_err(|e| Damage::Decompress(e.to_string()))?;
+    read_exactly(decoder, claims)
+}
+
+/// Reads `decoder` out, which must give exactly `claims` bytes (at most `claims + 1` are
+/// decompressed, to tell).
+fn read_exactly(decoder: impl Read, claims: u64) -> Result<Vec<u8>, Damage> {
     let mut out = Vec::with_capacity(claims.min(FIRST_RESERVE) as usize);
     decoder.take(claims + 1).read_to_end(&mut out).map_err(|e| Damage::Decompress(e.to_string()))?;
     let got = out.len() as u64;
@@ -112,8 +137,58 @@ mod tests {
             open(&h, &data[..data.len() / 2]),
             Err(Damage::Decompress(_) | Damage::ChunkSize { .. })
         ));
-        assert!(matches!(open(&header("lz4", 1, b"x"), b"x"), Err(Damage::Compression(_))));
+        assert!(matches!(open(&header("brotli", 1, b"x"), b"x"), Err(Damage::Compression(_))));
         let plain = open(&header("", 3, b"abc"), b"abc").expect("uncompressed");
         assert!(matches!(plain.records, Cow::Borrowed(b"abc")));
+    }
+
+    fn lz4(records: &[u8]) -> Vec<u8> {
+        let mut enc = lz4::EncoderBuilder::new().build(Vec::new()).expect("lz4 encoder");
+        std::io::Write::write_all(&mut enc, records).expect("compress");
+        let (data, result) = enc.finish();
+        result.expect("lz4 frame");
+        data
+    }
+
+    #[test]
+    fn an_lz4_chunk_opens_within_the_same_limits() {
+        let records: Vec<u8> = (0..100_000u32).map(|i| (i % 251) as u8).collect();
+        let data = lz4(&records);
+        let h = header("lz4", records.len() as u64, &records);
+        assert_eq!(&open(&h, &data).expect("intact").records[..], &records[..]);
+        let zeros = vec![0u8; 4 << 20];
+        let packed = lz4(&zeros);
+        assert!(open(&header("lz4", zeros.len() as u64, &zeros), &packed).is_ok(), "its best ratio");
+        let huge = ChunkHeader { uncompressed_size: 1 << 29, ..h.clone() };
+        assert!(matches!(open(&huge, &data), Err(Damage::ChunkTooLarge { .. })));
+        let long = ChunkHeader { uncompressed_size: records.len() as u64 + 1, ..h.clone() };
+        assert!(matches!(open(&long, &data), Err(Damage::ChunkSize { .. })));
+        assert!(open(&h, &data[..data.len() / 2]).is_err(), "a cut frame");
+    }
+
+    #[test]
+    fn recordings_of_every_compression_read_back_alike() {
+        let dir = std::env::temp_dir().join(format!("harvey-chunk-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("dir");
+        let mut seen = Vec::new();
+        use crate::ChunkCompression as C;
+        for (k, c) in [C::Zstd, C::ZstdFast, C::Lz4, C::None].into_iter().enumerate() {
+            let path = dir.join(format!("c{k}.mcap"));
+            let mut r = crate::Recorder::create_with(&path, c).expect("create");
+            let ch = r.image_channel("camera/frame").expect("channel");
+            for seq in 0..20u64 {
+                let h = harvey_msgs::FrameHeader::new(seq, seq * 1000, 64, 48, harvey_msgs::Encoding::Mono8);
+                let px: Vec<u8> = (0..64 * 48).map(|i| ((i as u64 * 7 + seq) % 256) as u8).collect();
+                r.record_frame(ch, &h, &px).expect("frame");
+            }
+            r.finish().expect("finish");
+            let rec = crate::Recording::open(&path).expect("open");
+            let data: Vec<Vec<u8>> =
+                rec.messages().expect("messages").map(|m| m.expect("message").data().to_vec()).collect();
+            assert_eq!(data.len(), 20, "{c:?}");
+            seen.push(data);
+        }
+        assert!(seen.windows(2).all(|w| w[0] == w[1]));
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }

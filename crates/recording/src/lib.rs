@@ -43,7 +43,7 @@ pub use damage::Damage;
 pub use data_files::DATA_MEDIA_TYPE;
 pub use error::RecordingError;
 pub use reader::{Message, Recording};
-pub use writer::{Channel, ChannelStats, Recorder};
+pub use writer::{Channel, ChannelStats, ChunkCompression, Recorder};
 
 /// Media type of the world file attached to a recording.
 pub const WORLD_MEDIA_TYPE: &str = "application/toml; harvey-world";

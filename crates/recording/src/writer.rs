@@ -22,6 +22,34 @@ const QOS_YAML: &str = "- history: 1\n  depth: 16\n  reliability: 1\n  durabilit
 /// MCAP's chunk size: large enough to compress well, small enough to bound a crash's loss.
 const CHUNK_BYTES: u64 = 4 << 20;
 
+/// How the recorder compresses its chunks. The MCAP writer compresses every chunk alike, so this
+/// is chosen for the file: camera frames are nearly all of its bytes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ChunkCompression {
+    /// zstd at its default level 3, on the writer's worker threads: small files, but a noisy
+    /// camera's 1080p frames come in faster than it keeps up (see `docs/benchmarks.md`).
+    #[default]
+    Zstd,
+    /// zstd at level 1: on two cores it keeps up with a noisy 1080p rgb8 camera at 60 Hz.
+    ZstdFast,
+    /// LZ4, on one thread (the mcap crate's): where one core is all the writer has.
+    Lz4,
+    /// Chunks stored as they are: for a disk faster than any compressor on this CPU.
+    None,
+}
+
+impl ChunkCompression {
+    /// The MCAP compression and level (0 is the codec's default).
+    fn mcap(self) -> (Option<mcap::Compression>, u32) {
+        match self {
+            Self::Zstd => (Some(mcap::Compression::Zstd), 0),
+            Self::ZstdFast => (Some(mcap::Compression::Zstd), 1),
+            Self::Lz4 => (Some(mcap::Compression::Lz4), 0),
+            Self::None => (None, 0),
+        }
+    }
+}
+
 /// One recorded channel and what went through it.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct ChannelStats {
@@ -45,13 +73,21 @@ pub struct Recorder {
 pub struct Channel(usize);
 
 impl Recorder {
+    /// A recording compressed with zstd.
     pub fn create(path: &Path) -> Result<Self, RecordingError> {
+        Self::create_with(path, ChunkCompression::Zstd)
+    }
+
+    /// A recording whose chunks are compressed as `compression` says.
+    pub fn create_with(path: &Path, compression: ChunkCompression) -> Result<Self, RecordingError> {
+        let (codec, level) = compression.mcap();
         let file =
             File::create(path).map_err(|cause| RecordingError::Create { file: path.to_owned(), cause })?;
         let writer = mcap::WriteOptions::new()
             .profile("ros2")
             .library(concat!("harvey-recorder ", env!("CARGO_PKG_VERSION")))
-            .compression(Some(mcap::Compression::Zstd))
+            .compression(codec)
+            .compression_level(level)
             .chunk_size(Some(CHUNK_BYTES))
             .create(BufWriter::new(file))
             .map_err(|cause| RecordingError::Write { file: path.to_owned(), cause })?;

@@ -1,7 +1,8 @@
 //! Recording throughput: the real recorder process records 1080p rgb8 camera frames (rendered
-//! hallway views) published over the bus at 30, 60 and 120 Hz and flat out; reported as frame
-//! MB/s taken in and drops, against the disk's sequential write speed measured in the same run
-//! (the same bytes written raw to a file and synced).
+//! hallway views: clean, and with the shipped world's camera noise and the `harsh` condition's)
+//! published over the bus at 30, 60 and 120 Hz and flat out; reported as frame MB/s taken in and
+//! drops, against the disk's sequential write speed measured in the same run (the same bytes
+//! written raw to a file and synced).
 //!
 //! Run: `cargo build --release --workspace && cargo bench -p harvey-recorder --bench throughput`.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
@@ -43,6 +44,8 @@ fn disk_mb_s(dir: &Path, bytes: usize) -> f64 {
 }
 
 struct Run {
+    frames: &'static str,
+    compression: &'static str,
     rate: String,
     sent: u64,
     recorded: u64,
@@ -50,11 +53,19 @@ struct Run {
     file_mb: f64,
 }
 
-fn record(dir: &Path, frames: &[Vec<u8>], rate_hz: Option<f64>, seconds: f64, tag: usize) -> Run {
+fn record(
+    dir: &Path,
+    set: &FrameSet,
+    compression: &'static str,
+    rate_hz: Option<f64>,
+    seconds: f64,
+    tag: usize,
+) -> Run {
+    let frames = &set.frames;
     let prefix = format!("rtp{}x{tag}_", std::process::id());
     let mcap = dir.join(format!("bench-{tag}.mcap"));
     let mut recorder: Child = Command::new(bin_dir().join("harvey-recorder"))
-        .args(["--output", mcap.to_str().expect("utf8")])
+        .args(["--output", mcap.to_str().expect("utf8"), "--compression", compression])
         .env(harvey_bus::PREFIX_ENV, &prefix)
         .stderr(Stdio::null())
         .spawn()
@@ -100,6 +111,8 @@ fn record(dir: &Path, frames: &[Vec<u8>], rate_hz: Option<f64>, seconds: f64, ta
     let _ = harvey_bus::retire_domain(&prefix);
     let rate = rate_hz.map_or("flat out".into(), |hz| format!("{hz} Hz"));
     Run {
+        frames: set.name,
+        compression,
         rate,
         sent,
         recorded,
@@ -108,31 +121,93 @@ fn record(dir: &Path, frames: &[Vec<u8>], rate_hz: Option<f64>, seconds: f64, ta
     }
 }
 
-fn main() {
-    let world_path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../worlds/hallway.toml");
-    let world = harvey_world::World::load(Path::new(world_path)).expect("world");
-    let mut r = Renderer::new(&world, W, H, Encoding::Rgb8);
-    let frames: Vec<Vec<u8>> = (0..16)
+/// Frames cycled through in one set of runs, and what they are.
+struct FrameSet {
+    name: &'static str,
+    frames: Vec<Vec<u8>>,
+}
+
+/// Rendered hallway views through `world`'s camera (its light, noise, vignetting and blur): the
+/// noise is drawn per frame, so no two frames share it (zstd cannot match one against another).
+fn frame_set(name: &'static str, world: &harvey_world::World) -> FrameSet {
+    let mut r = Renderer::new(world, W, H, Encoding::Rgb8);
+    let effects = harvey_render::Effects::from_camera(&world.camera, 7);
+    let frames = (0..16)
         .map(|i| {
             let mut px = vec![0u8; r.frame_bytes()];
-            r.render(&world, harvey_world::Pose2::new(0.5 * i as f64, 0.1, 0.05 * i as f64), &mut px)
+            r.render(world, harvey_world::Pose2::new(0.5 * i as f64, 0.1, 0.05 * i as f64), &mut px)
                 .expect("render");
+            effects.apply(W as usize, H as usize, 3, i, &mut px);
             px
         })
         .collect();
+    FrameSet { name, frames }
+}
+
+/// The hallway under `conditions/harsh.toml`'s camera (its light, noise, vignetting and blur).
+fn harsh_world(world: &harvey_world::World) -> harvey_world::World {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../conditions/harsh.toml");
+    let text = std::fs::read_to_string(path).expect("conditions/harsh.toml");
+    let table: toml::Table = text.parse().expect("harsh.toml parses");
+    let camera = table["camera"].as_table().expect("[camera]");
+    let num = |key: &str| camera[key].as_float().expect(key);
+    let mut w = world.clone();
+    w.camera.illumination = num("illumination");
+    w.camera.noise_sd = num("noise_sd");
+    w.camera.vignetting = num("vignetting");
+    w.camera.blur_px = camera["blur_px"].as_integer().expect("blur_px") as u32;
+    w
+}
+
+fn main() {
+    let world_path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../worlds/hallway.toml");
+    let world = harvey_world::World::load(Path::new(world_path)).expect("world");
+    let mut clean = world.clone();
+    clean.camera.noise_sd = 0.0;
+    clean.camera.vignetting = 0.0;
+    clean.camera.illumination_drift = 0.0;
+    let sets = [
+        frame_set("clean render", &clean),
+        frame_set("world's camera", &world),
+        frame_set("harsh camera", &harsh_world(&world)),
+    ];
+    // `cargo bench … -- TEXT` runs only the rows whose frames, compression or rate contain TEXT.
+    let only: Option<String> = std::env::args().skip(1).find(|a| !a.starts_with('-'));
+    let wanted = |set: &str, compression: &str, hz: Option<f64>| {
+        let rate = hz.map_or("flat out".into(), |hz| format!("{hz} Hz"));
+        only.as_ref().is_none_or(|o| [set, compression, rate.as_str()].join(" / ").contains(o.as_str()))
+    };
     let dir = bin_dir();
     let seconds = 4.0;
-    let runs: Vec<Run> = [Some(30.0), Some(60.0), Some(120.0), None]
-        .into_iter()
-        .enumerate()
-        .map(|(k, hz)| record(&dir, &frames, hz, seconds, k))
-        .collect();
+    let mut runs = Vec::new();
+    for hz in [Some(30.0), Some(60.0), Some(120.0), None] {
+        if !wanted(sets[0].name, "zstd", hz) {
+            continue;
+        }
+        let tag = runs.len();
+        runs.push(record(&dir, &sets[0], "zstd", hz, seconds, tag));
+    }
+    for set in &sets[1..] {
+        for compression in ["zstd", "zstd-fast", "lz4", "none"] {
+            for hz in [Some(60.0), Some(120.0), None] {
+                if !wanted(set.name, compression, hz) {
+                    continue;
+                }
+                let tag = runs.len();
+                runs.push(record(&dir, set, compression, hz, seconds, tag));
+            }
+        }
+    }
     let disk = disk_mb_s(&dir, 1 << 30);
-    println!("| 1080p rgb8 frames | sent | recorded | drops | frame MB/s in | MCAP MB written | vs disk |");
-    println!("|---|---:|---:|---:|---:|---:|---:|");
+    println!(
+        "| 1080p rgb8 frames | compression | rate | sent | recorded | drops | frame MB/s in | MCAP MB written | vs disk |"
+    );
+    println!("|---|---|---|---:|---:|---:|---:|---:|---:|");
     for run in &runs {
         println!(
-            "| {} | {} | {} | {} | {:.0} | {:.0} | {:.0} % |",
+            "| {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {:.0} % |",
+            run.frames,
+            run.compression,
             run.rate,
             run.sent,
             run.recorded,
@@ -140,6 +215,14 @@ fn main() {
             run.mb_s,
             run.file_mb,
             100.0 * run.mb_s / disk
+        );
+    }
+    let harsh = harsh_world(&world);
+    for (name, w) in [("world's camera", &world), ("harsh camera", &harsh)] {
+        let c = &w.camera;
+        println!(
+            "{name}: illumination {}, noise sd {}, vignetting {}, blur {} px",
+            c.illumination, c.noise_sd, c.vignetting, c.blur_px
         );
     }
     println!("\ndisk sequential write, same run: {disk:.0} MB/s (1 GiB in 4 MiB blocks, synced)");

@@ -13,7 +13,7 @@ use harvey_bus::{Bus, Pace, Step, Waitable, Waiter};
 use harvey_cdr::Ros2Msg;
 use harvey_msgs::{Message, Topic, topics};
 use harvey_recording::rrd::RrdWriter;
-use harvey_recording::{Recorder, data_files};
+use harvey_recording::{ChunkCompression, Recorder, data_files};
 
 mod taps;
 mod writer;
@@ -47,6 +47,30 @@ struct Args {
     /// The launch file of the run: attached to the MCAP file for `harvey replay`.
     #[arg(long)]
     launch: Option<PathBuf>,
+    /// How chunks are compressed: `zstd` (smallest), `zstd-fast` (a noisy 1080p camera at 60 Hz
+    /// on two cores), `lz4` (one thread) or `none`. `docs/benchmarks.md` compares them.
+    #[arg(long, value_enum, default_value_t = Compression::Zstd)]
+    compression: Compression,
+}
+
+/// `--compression`'s values.
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum Compression {
+    Zstd,
+    ZstdFast,
+    Lz4,
+    None,
+}
+
+impl From<Compression> for ChunkCompression {
+    fn from(c: Compression) -> Self {
+        match c {
+            Compression::Zstd => Self::Zstd,
+            Compression::ZstdFast => Self::ZstdFast,
+            Compression::Lz4 => Self::Lz4,
+            Compression::None => Self::None,
+        }
+    }
 }
 
 fn tap<T: Message + Ros2Msg>(bus: &Bus, rec: &mut Recorder, topic: Topic<T>) -> anyhow::Result<Box<dyn Tap>> {
@@ -57,7 +81,7 @@ fn tap<T: Message + Ros2Msg>(bus: &Bus, rec: &mut Recorder, topic: Topic<T>) -> 
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
-    let mut rec = Recorder::create(&args.output)?;
+    let mut rec = Recorder::create_with(&args.output, args.compression.into())?;
     let world = match &args.world {
         Some(path) => {
             let text =
