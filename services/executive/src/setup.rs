@@ -18,7 +18,7 @@ use crate::script::Script;
 use crate::script::leg::ServoSetup;
 use crate::servo::ServoParams;
 use crate::servo::pose::{PinholeCamera, RefineParams};
-use crate::servo::vertices::RefineSetup;
+use crate::servo::vertices::{Growth, RefineSetup};
 use crate::{Executive, Mode};
 
 /// Why no executive could be built for a mission.
@@ -184,12 +184,15 @@ impl Site<'_> {
             },
             params: RefineParams {
                 prior_sd: [r.prior_sd[0], r.prior_sd[1], r.prior_sd[2].to_radians()],
+                pitch_sd_rad: w.survey.calibration_sd_rad,
                 image_sd_px: 0.5,
+                map_sd_m: w.survey.position_sd_m,
                 gate_px: r.gate_px,
             },
             template_px: r.template_px,
             min_score: r.min_score,
             max_sd_m: r.max_sd_m.unwrap_or(f64::INFINITY),
+            growth: Growth::of(w),
             world: Some(w.clone()),
         }))
     }

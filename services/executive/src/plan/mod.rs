@@ -10,7 +10,7 @@ use harvey_msgs::{MissionState, Odometry, Pose2, VisionResult};
 
 use crate::Output;
 use crate::mission::Step;
-use crate::script::{More, Script, Sequel};
+use crate::script::{Fixes, More, Script, Sequel};
 use monitor::{Monitor, Next};
 
 /// The plan under way: the monitor and the script it appends to.
@@ -57,8 +57,9 @@ impl Sequel for Developing<'_> {
         self.monitor.goal_pose()
     }
 
-    fn more(&mut self, at: Pose2, fixes: u32, now: u64, out: &mut Vec<Output>) -> More {
-        let next = self.monitor.next(at, fixes);
+    fn more(&mut self, at: Pose2, fixes: Fixes, now: u64, out: &mut Vec<Output>) -> More {
+        self.monitor.last_fix_sd(fixes.last_sd_m);
+        let next = self.monitor.next(at, fixes.count);
         *self.sketches += 1;
         out.push(Output::Plan(self.monitor.sketch_msg(*self.sketches, now)));
         match next {

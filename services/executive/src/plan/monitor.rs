@@ -18,6 +18,9 @@ const NEGLIGIBLE_TURN_RAD: f64 = 0.2 * std::f64::consts::PI / 180.0;
 const NEGLIGIBLE_MOVE_M: f64 = 0.003;
 /// A near target to one side is approached from this many `back_off_m` behind it.
 const BACK_OFF_FACTOR: f64 = 1.5;
+/// A fixed check this many of the fix's standard deviations from its milestone is as near as
+/// the fix can tell (two: about 95 % of fixes of a robot at the milestone).
+const FIX_SIGMAS: f64 = 2.0;
 
 /// How a milestone check came out.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -80,6 +83,8 @@ pub struct Monitor {
     /// the next step boundary; how often that happened.
     relocate: bool,
     pub relocations: u32,
+    /// The last pose fix's position standard deviation (m).
+    fix_sd_m: f64,
 }
 
 fn turn(rad: f64) -> Step {
@@ -112,6 +117,7 @@ impl Monitor {
             checks: Vec::new(),
             relocate: false,
             relocations: 0,
+            fix_sd_m: 0.0,
         }
     }
 
@@ -155,6 +161,11 @@ impl Monitor {
             tracing::warn!("the UMS reports the robot lost: relocating");
             self.relocate = true;
         }
+    }
+
+    /// The last pose fix placed the robot to `sd_m` (its standard deviation, map error in).
+    pub fn last_fix_sd(&mut self, sd_m: f64) {
+        self.fix_sd_m = sd_m;
     }
 
     /// What to do once the steps given last are done, from the believed pose `at`; `fixes` counts
@@ -276,14 +287,17 @@ impl Monitor {
     /// The milestone check at the end of subgoal `sub`.
     fn check(&mut self, sub: &Ptrans, at: Pose2, off_m: f64, fixed: bool) -> Result<(), PlanError> {
         let tolerance = self.tolerance();
-        let outcome = if off_m <= tolerance {
+        // A fix cannot tell the robot from a place nearer than it can see: another move would
+        // chase the fix's own error (000 §5: servoing is as good as its pose fixes).
+        let told = fixed && off_m <= FIX_SIGMAS * self.fix_sd_m;
+        let outcome = if off_m <= tolerance || told {
             Outcome::Reached
         } else if off_m < self.goal.escalate_m && self.attempts + 1 < self.goal.attempts {
             Outcome::Retried
         } else {
             Outcome::Replanned
         };
-        tracing::info!(milestone = %sub.to.name, off_m, fixed, ?outcome, "milestone check");
+        tracing::info!(milestone = %sub.to.name, off_m, fixed, fix_sd_m = self.fix_sd_m, ?outcome, "milestone check");
         let at_xy = [at.x_m, at.y_m];
         self.checks.push(Check {
             milestone: sub.to.name.clone(),

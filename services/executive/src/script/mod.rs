@@ -70,8 +70,17 @@ pub trait Sequel {
     fn goal(&self, at: Pose2, steps: &[Step]) -> Pose2;
 
     /// The script's steps are done (or there were none) with the robot believed at `at`, after
-    /// `fixes` pose fixes: what comes next; anything to publish first goes to `out`.
-    fn more(&mut self, at: Pose2, fixes: u32, now: u64, out: &mut Vec<Output>) -> More;
+    /// `fixes`: what comes next; anything to publish first goes to `out`.
+    fn more(&mut self, at: Pose2, fixes: Fixes, now: u64, out: &mut Vec<Output>) -> More;
+}
+
+/// The pose fixes a script has made, and how well the last one placed the robot.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Fixes {
+    pub count: u32,
+    /// The last fix's position standard deviation, map error included
+    /// (`Refined::map_position_sd_m`), m; 0 before any.
+    pub last_sd_m: f64,
 }
 
 /// A script and nothing after it: the mission succeeds when its last step is done.
@@ -83,7 +92,7 @@ impl Sequel for End {
         goal_of(at, steps)
     }
 
-    fn more(&mut self, _: Pose2, _: u32, _: u64, _: &mut Vec<Output>) -> More {
+    fn more(&mut self, _: Pose2, _: Fixes, _: u64, _: &mut Vec<Output>) -> More {
         More::End(MissionState::Succeeded)
     }
 }
@@ -120,8 +129,10 @@ pub struct Script {
     refine: Option<RefineSetup>,
     asked: Vec<usize>,
     looks: Vec<Option<[f64; 2]>>,
-    /// Pose fixes made so far.
+    /// Pose fixes made so far…
     pub fixes: u32,
+    /// …and the last one's position standard deviation (m).
+    fix_sd_m: f64,
     /// Odometry and the last fix.
     belief: Belief,
     /// Times a reflex interrupted the mission.
@@ -156,6 +167,7 @@ impl Script {
             asked: Vec::new(),
             looks: Vec::new(),
             fixes: 0,
+            fix_sd_m: 0.0,
             belief: Belief::default(),
             preemptions: 0,
             handled_reflex: 0,

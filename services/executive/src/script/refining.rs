@@ -10,6 +10,10 @@ use crate::Output;
 use crate::servo::pose::{VertexMatch, refine};
 use crate::servo::vertices::MIN_ASKED;
 
+/// A fix that moves the pose further from the expected one than this (chi-square, three degrees
+/// of freedom, 0.999) says more about false matches than about the robot: refused.
+const SURPRISE_LIMIT: f64 = 16.27;
+
 /// Results not in this long (ns) after the requests are taken as not found.
 pub const WAIT_NS: u64 = 2_000_000_000;
 
@@ -84,13 +88,23 @@ impl Script {
             .filter_map(|(world_m, seen)| seen.map(|image_px| VertexMatch { world_m, image_px }))
             .collect();
         let expected = self.estimated;
+        // The prior is what dead reckoning since the last fix leaves of the pose.
+        let params = setup.growth.widen(&setup.params, self.belief.travelled_m());
         let mut out = Vec::new();
-        match refine(&setup.camera, expected, &matches, &setup.params) {
+        match refine(&setup.camera, expected, &matches, &params) {
             // Too few matches agreeing: no fix (a pose from two vertices fits anything).
             Some(done) if done.kept.len() < MIN_ASKED => tracing::warn!(
                 found = matches.len(),
                 kept = done.kept.len(),
                 "too few vertices agree to fix the pose"
+            ),
+            Some(done) if done.surprise(expected, params.prior_sd) > SURPRISE_LIMIT => tracing::warn!(
+                refined_x = done.pose.x_m,
+                refined_y = done.pose.y_m,
+                refined_heading_deg = done.pose.heading_rad.to_degrees(),
+                surprise = done.surprise(expected, params.prior_sd),
+                vertices = done.kept.len(),
+                "the fix moves the pose further than its prior allows: refused"
             ),
             Some(done) if done.position_sd_m > setup.max_sd_m => tracing::warn!(
                 position_sd_m = done.position_sd_m,
@@ -113,6 +127,7 @@ impl Script {
                 self.belief.fix(done.pose);
                 self.estimated = done.pose;
                 self.fixes += 1;
+                self.fix_sd_m = done.map_position_sd_m;
                 self.servo_seq += 1;
                 out.push(Output::Pose(PoseFix {
                     header: Header::new(self.servo_seq, now),

@@ -8,7 +8,7 @@ use harvey_msgs::{
 };
 
 use super::leg::{Leg, LegStep};
-use super::{More, Phase, Script, Sequel, recover};
+use super::{Fixes, More, Phase, Script, Sequel, recover};
 use crate::Output;
 
 impl Script {
@@ -114,7 +114,8 @@ impl Script {
     /// The sequel's next steps, appended to the script and begun, or the mission's end.
     fn more(&mut self, at: Pose2, now: u64, sequel: &mut dyn Sequel) -> Vec<Output> {
         let mut out = Vec::new();
-        match sequel.more(at, self.fixes, now, &mut out) {
+        let fixes = Fixes { count: self.fixes, last_sd_m: self.fix_sd_m };
+        match sequel.more(at, fixes, now, &mut out) {
             More::Steps(steps) => {
                 let first = self.steps.len();
                 self.steps.extend(steps);

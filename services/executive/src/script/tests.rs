@@ -10,7 +10,7 @@ use super::leg::Tracking;
 use super::{Script, WAIT_NS};
 use crate::mission::{Servo, Step};
 use crate::servo::pose::{PinholeCamera, RefineParams};
-use crate::servo::vertices::RefineSetup;
+use crate::servo::vertices::{Growth, RefineSetup};
 use crate::{Executive, Mode, Output};
 
 fn two_steps() -> Vec<Step> {
@@ -229,10 +229,17 @@ fn refining() -> RefineSetup {
     RefineSetup {
         vertices: vertices.iter().enumerate().map(|(i, &v)| (i as u32, [0.0; 3], v)).collect(),
         camera: PinholeCamera { focal_px: 554.0, centre_px: [320.0, 240.0], height_m: 1.2 },
-        params: RefineParams { prior_sd: [0.3, 0.3, 3f64.to_radians()], image_sd_px: 0.5, gate_px: 3.0 },
+        params: RefineParams {
+            prior_sd: [0.3, 0.3, 3f64.to_radians()],
+            pitch_sd_rad: 0.003,
+            image_sd_px: 0.5,
+            map_sd_m: 0.01,
+            gate_px: 3.0,
+        },
         template_px: 16,
         min_score: 0.9,
         max_sd_m: f64::INFINITY,
+        growth: Growth::default(),
         world: None,
     }
 }

@@ -4,22 +4,30 @@
 
 use harvey_msgs::Pose2;
 
-/// Odometry now, and the last fix.
+/// Odometry now, the last fix, and how far odometry says the robot went since.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Belief {
     odometry: Pose2,
     fix: Option<(Pose2, Pose2)>,
+    travelled_m: f64,
 }
 
 impl Belief {
     /// Odometry's latest pose.
     pub fn set_odometry(&mut self, odometry: Pose2) {
+        self.travelled_m += (odometry.x_m - self.odometry.x_m).hypot(odometry.y_m - self.odometry.y_m);
         self.odometry = odometry;
     }
 
     /// The robot is at `pose` now (odometry's latest pose is the one it goes with).
     pub fn fix(&mut self, pose: Pose2) {
         self.fix = Some((self.odometry, pose));
+        self.travelled_m = 0.0;
+    }
+
+    /// The path odometry measured since the last fix (since the start without one), m.
+    pub fn travelled_m(&self) -> f64 {
+        self.travelled_m
     }
 
     /// Whether any fix has been taken.

@@ -6,6 +6,7 @@
 
 pub mod action;
 pub mod belief;
+pub mod linalg;
 pub mod pose;
 pub mod vertices;
 

@@ -1,12 +1,19 @@
 //! Pose refinement for plan-level servoing (000 §5.6, after Kumar's 3D pose refinement): the
-//! robot's pose `(x, y, heading)` that best projects the matched landmark vertices onto where
-//! correlation found them, by Gauss-Newton from the expected pose, with the expected pose as a
-//! weak prior (a vertex row says little about the distance along the hall) and matches that
-//! disagree with the rest dropped, worst first.
+//! robot's pose `(x, y, heading)` and the camera mount's pitch that best project the matched
+//! landmark vertices onto where correlation found them, by Gauss-Newton from the expected pose,
+//! with the expected pose as a weak prior (a vertex row says little about the distance along the
+//! hall) and the mount's surveyed pitch as another, and matches that disagree with the rest
+//! dropped, worst first. The pitch is an unknown because it moves every row alike (000 §5.5
+//! Fig. 10): 3 mrad is 1.7 px at 554 px focal length, which a level camera model reads as the
+//! vertices a third of a metre nearer or further at 8 m. The mount's yaw needs no unknown of its
+//! own: it turns every column alike, as the heading does, and the position is unaffected.
 
 use harvey_msgs::Pose2;
 
-/// The camera: pinhole at the robot's centre, level, looking along its heading.
+use crate::servo::linalg::{N, inverse, sandwich, solve_n};
+
+/// The camera: pinhole at the robot's centre, looking along its heading, level as far as the
+/// robot knows (the pitch is [`RefineParams::pitch_sd_rad`]'s unknown).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PinholeCamera {
     pub focal_px: f64,
@@ -16,14 +23,21 @@ pub struct PinholeCamera {
 }
 
 impl PinholeCamera {
-    /// Where the world point `p` appears from `pose`, or `None` behind the camera.
+    /// Where the world point `p` appears from `pose` through a level camera, or `None` behind it.
     pub fn project(&self, pose: Pose2, p: [f64; 3]) -> Option<[f64; 2]> {
+        self.project_tilted(pose, 0.0, p)
+    }
+
+    /// …through a camera tilted `pitch_rad` down on its mount (small angles, as the renderer
+    /// tilts it: every row's ray turned by the same angle).
+    pub fn project_tilted(&self, pose: Pose2, pitch_rad: f64, p: [f64; 3]) -> Option<[f64; 2]> {
         let (dx, dy) = (p[0] - pose.x_m, p[1] - pose.y_m);
         let (c, s) = (pose.heading_rad.cos(), pose.heading_rad.sin());
         let (ahead, left) = (dx * c + dy * s, -dx * s + dy * c);
         (ahead > 0.05).then(|| {
             let f = self.focal_px;
-            [self.centre_px[0] - f * left / ahead, self.centre_px[1] - f * (p[2] - self.height_m) / ahead]
+            let down = ((self.height_m - p[2]) / ahead).atan() - pitch_rad;
+            [self.centre_px[0] - f * left / ahead, self.centre_px[1] + f * down.tan()]
         })
     }
 }
@@ -35,13 +49,20 @@ pub struct VertexMatch {
     pub image_px: [f64; 2],
 }
 
-/// Settings: the prior's standard deviations and the outlier gate.
+/// Settings: the priors' standard deviations and the outlier gate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RefineParams {
     /// How well the expected pose is known: along x and y (m) and in heading (rad).
     pub prior_sd: [f64; 3],
+    /// How well the mount's pitch is known about level (rad): the world's `[survey]
+    /// calibration_sd_rad`. Zero holds the camera level.
+    pub pitch_sd_rad: f64,
     /// A match's image position is good to this (pixels)…
     pub image_sd_px: f64,
+    /// …and its vertex's mapped place to this (m: the world's `[survey] position_sd_m`). It
+    /// does not weight the matches (a near vertex carries the depth), but it is in
+    /// [`Refined::map_position_sd_m`].
+    pub map_sd_m: f64,
     /// …and one further than this from its projection is dropped.
     pub gate_px: f64,
 }
@@ -50,6 +71,8 @@ pub struct RefineParams {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Refined {
     pub pose: Pose2,
+    /// The mount's pitch the matches say (rad, down positive).
+    pub pitch_rad: f64,
     /// Root-mean-square image residual of the matches kept (pixels).
     pub rms_px: f64,
     /// Indices of the matches kept.
@@ -58,9 +81,31 @@ pub struct Refined {
     /// covariance's trace (m), for image rows good to `image_sd_px`. Vertices all at one depth
     /// leave sideways and turned hard to tell apart, and this large.
     pub position_sd_m: f64,
+    /// The same with each vertex's map error in as well (`RefineParams::map_sd_m`, moving it up
+    /// to `focal * map_sd / depth` pixels): how far the fix may be from the truth, which no
+    /// image residual shows.
+    pub map_position_sd_m: f64,
 }
 
-/// Gauss-Newton on `(x, y, heading)`; `None` with fewer than two matches left.
+impl Refined {
+    /// How far the fix moved the pose from `expected`, squared, in the prior's standard
+    /// deviations (`prior_sd`: x and y in m, heading in rad): chi-square with three degrees of
+    /// freedom for a fix that agrees with its prior.
+    pub fn surprise(&self, expected: Pose2, prior_sd: [f64; 3]) -> f64 {
+        let shift = [
+            self.pose.x_m - expected.x_m,
+            self.pose.y_m - expected.y_m,
+            harvey_geometry::wrap(self.pose.heading_rad - expected.heading_rad),
+        ];
+        shift.iter().zip(prior_sd).map(|(d, sd)| (d / sd.max(HELD_SD)).powi(2)).sum()
+    }
+}
+
+/// The smallest prior standard deviation used, so that a pitch held level keeps the normal
+/// equations well scaled.
+const HELD_SD: f64 = 1e-6;
+
+/// Gauss-Newton on `(x, y, heading, pitch)`; `None` with fewer than two matches left.
 pub fn refine(
     cam: &PinholeCamera,
     expected: Pose2,
@@ -72,9 +117,9 @@ pub fn refine(
         if kept.len() < 2 {
             return None;
         }
-        let (pose, information) = solve(cam, expected, matches, &kept, p)?;
+        let (pose, pitch_rad, normal) = solve(cam, expected, matches, &kept, p)?;
         let residual = |i: usize| {
-            cam.project(pose, matches[i].world_m).map_or(f64::INFINITY, |q| {
+            cam.project_tilted(pose, pitch_rad, matches[i].world_m).map_or(f64::INFINITY, |q| {
                 (q[0] - matches[i].image_px[0]).hypot(q[1] - matches[i].image_px[1])
             })
         };
@@ -84,91 +129,84 @@ pub fn refine(
             continue;
         }
         let rms = (kept.iter().map(|&i| residual(i).powi(2)).sum::<f64>() / kept.len() as f64).sqrt();
-        let variance = |k: usize| {
-            let mut e = [0.0; 3];
-            e[k] = 1.0;
-            solve3(information, e).map_or(f64::INFINITY, |c| c[k])
-        };
-        let position_sd_m = (variance(0) + variance(1)).sqrt();
-        return Some(Refined { pose, rms_px: rms, kept, position_sd_m });
+        let position_sd = |c: Option<[[f64; N]; N]>| c.map_or(f64::INFINITY, |c| (c[0][0] + c[1][1]).sqrt());
+        let position_sd_m = position_sd(inverse(normal.information));
+        let map_position_sd_m = position_sd(sandwich(normal.information, normal.spread));
+        return Some(Refined { pose, pitch_rad, rms_px: rms, kept, position_sd_m, map_position_sd_m });
     }
 }
 
-/// The weighted least-squares pose of the matches `kept` with the prior, by Gauss-Newton, and
-/// the information matrix at it (the inverse of its covariance).
+/// The normal equations at the solution: `information = Jᵀ W J` (the inverse of the covariance
+/// for the image noise alone) and `spread = Jᵀ W R W J`, with `R` the image noise and the map
+/// error together.
+struct Normal {
+    information: [[f64; N]; N],
+    spread: [[f64; N]; N],
+}
+
+/// The weighted least-squares pose and pitch of the matches `kept` with the priors, by
+/// Gauss-Newton, and the normal equations at it.
 fn solve(
     cam: &PinholeCamera,
     expected: Pose2,
     m: &[VertexMatch],
     kept: &[usize],
     p: &RefineParams,
-) -> Option<(Pose2, [[f64; 3]; 3])> {
-    let as_pose = |v: [f64; 3]| Pose2 { x_m: v[0], y_m: v[1], heading_rad: v[2] };
-    let prior = [expected.x_m, expected.y_m, expected.heading_rad];
+) -> Option<(Pose2, f64, Normal)> {
+    let project = |v: [f64; N], w: [f64; 3]| {
+        cam.project_tilted(Pose2 { x_m: v[0], y_m: v[1], heading_rad: v[2] }, v[3], w)
+    };
+    let prior = [expected.x_m, expected.y_m, expected.heading_rad, 0.0];
+    let prior_sd = [p.prior_sd[0], p.prior_sd[1], p.prior_sd[2], p.pitch_sd_rad].map(|sd| sd.max(HELD_SD));
     let mut v = prior;
-    let mut information = [[0.0f64; 3]; 3];
+    let mut normal = Normal { information: [[0.0; N]; N], spread: [[0.0; N]; N] };
     for _ in 0..20 {
-        // Normal equations A d = b from the image rows and the prior.
-        let (mut a, mut b) = ([[0.0f64; 3]; 3], [0.0f64; 3]);
-        let mut add = |j: [f64; 3], r: f64, w: f64| {
-            for (row, &jr) in a.iter_mut().zip(&j) {
-                for (cell, &jc) in row.iter_mut().zip(&j) {
+        // Normal equations A d = b from the image rows and columns and the priors; `spread`
+        // beside them with each row's variance (`var`) as the image noise and map error give it.
+        let (mut a, mut b, mut spread) = ([[0.0f64; N]; N], [0.0f64; N], [[0.0f64; N]; N]);
+        let mut add = |j: [f64; N], r: f64, w: f64, var: f64| {
+            for ((row, spread_row), &jr) in a.iter_mut().zip(spread.iter_mut()).zip(&j) {
+                for ((cell, spread_cell), &jc) in row.iter_mut().zip(spread_row.iter_mut()).zip(&j) {
                     *cell += w * jr * jc;
+                    *spread_cell += w * w * var * jr * jc;
                 }
             }
             for (bi, &ji) in b.iter_mut().zip(&j) {
                 *bi += w * ji * r;
             }
         };
-        let w_img = 1.0 / (p.image_sd_px * p.image_sd_px);
+        let image_var = p.image_sd_px * p.image_sd_px;
         for &i in kept {
-            let at = cam.project(as_pose(v), m[i].world_m)?;
+            let at = project(v, m[i].world_m)?;
+            let (dx, dy) = (m[i].world_m[0] - v[0], m[i].world_m[1] - v[1]);
+            let depth = (dx * v[2].cos() + dy * v[2].sin()).max(0.05);
+            let var = image_var + (cam.focal_px * p.map_sd_m / depth).powi(2);
             for (axis, &now) in at.iter().enumerate() {
-                let mut j = [0.0; 3];
+                let mut j = [0.0; N];
                 for (k, jk) in j.iter_mut().enumerate() {
                     let mut h = v;
                     h[k] += 1e-6;
-                    *jk = (cam.project(as_pose(h), m[i].world_m)?[axis] - now) / 1e-6;
+                    *jk = (project(h, m[i].world_m)?[axis] - now) / 1e-6;
                 }
-                add(j, m[i].image_px[axis] - now, w_img);
+                add(j, m[i].image_px[axis] - now, 1.0 / image_var, var);
             }
         }
-        for k in 0..3 {
-            let mut j = [0.0; 3];
+        for k in 0..N {
+            let mut j = [0.0; N];
             j[k] = 1.0;
-            add(j, prior[k] - v[k], 1.0 / (p.prior_sd[k] * p.prior_sd[k]));
+            let var = prior_sd[k] * prior_sd[k];
+            add(j, prior[k] - v[k], 1.0 / var, var);
         }
-        information = a;
-        let d = solve3(a, b)?;
-        for k in 0..3 {
+        normal = Normal { information: a, spread };
+        let d = solve_n(a, b)?;
+        for k in 0..N {
             v[k] += d[k];
         }
         if d.iter().all(|x| x.abs() < 1e-7) {
             break;
         }
     }
-    Some((as_pose(v), information))
-}
-
-/// `A x = b` for a 3x3 system (Cramer's rule); `None` when singular.
-fn solve3(a: [[f64; 3]; 3], b: [f64; 3]) -> Option<[f64; 3]> {
-    let det = |m: [[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(a);
-    if d.abs() < 1e-300 {
-        return None;
-    }
-    let mut x = [0.0; 3];
-    for (k, xk) in x.iter_mut().enumerate() {
-        let mut m = a;
-        for r in 0..3 {
-            m[r][k] = b[r];
-        }
-        *xk = det(m) / d;
-    }
-    Some(x)
+    Some((Pose2 { x_m: v[0], y_m: v[1], heading_rad: v[2] }, v[3], normal))
 }
 
 #[cfg(test)]
@@ -198,7 +236,13 @@ mod tests {
     #[test]
     fn an_expected_pose_inches_off_is_refined_to_the_true_one_despite_an_outlier() {
         let truth = Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: 0.01 };
-        let params = RefineParams { prior_sd: [0.3, 0.3, 0.1], image_sd_px: 0.5, gate_px: 3.0 };
+        let params = RefineParams {
+            prior_sd: [0.3, 0.3, 0.1],
+            pitch_sd_rad: 0.0,
+            image_sd_px: 0.5,
+            map_sd_m: 0.0,
+            gate_px: 3.0,
+        };
         let mut matches: Vec<VertexMatch> = vertices()
             .into_iter()
             .enumerate()
@@ -224,7 +268,13 @@ mod tests {
 
     #[test]
     fn vertices_all_at_one_depth_fix_the_position_loosely() {
-        let params = RefineParams { prior_sd: [0.3, 0.3, 0.1], image_sd_px: 0.5, gate_px: 3.0 };
+        let params = RefineParams {
+            prior_sd: [0.3, 0.3, 0.1],
+            pitch_sd_rad: 0.0,
+            image_sd_px: 0.5,
+            map_sd_m: 0.0,
+            gate_px: 3.0,
+        };
         let at = Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: 0.0 };
         let exact = |w: &[[f64; 3]]| -> Vec<VertexMatch> {
             w.iter()
@@ -249,5 +299,35 @@ mod tests {
             flat.position_sd_m,
             deep.position_sd_m
         );
+    }
+
+    #[test]
+    fn a_mount_tilted_a_few_milliradians_is_solved_for_not_read_as_distance() {
+        let truth = Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: 0.0 };
+        let tilt = 0.004;
+        let matches: Vec<VertexMatch> = vertices()
+            .into_iter()
+            .map(|w| VertexMatch {
+                world_m: w,
+                image_px: cam().project_tilted(truth, tilt, w).expect("in front"),
+            })
+            .collect();
+        let expected = Pose2 { x_m: 0.1, y_m: 0.05, ..truth };
+        let error = |pitch_sd_rad: f64| {
+            let params = RefineParams {
+                prior_sd: [0.3, 0.3, 0.1],
+                pitch_sd_rad,
+                image_sd_px: 0.5,
+                map_sd_m: 0.0,
+                gate_px: 30.0,
+            };
+            let r = refine(&cam(), expected, &matches, &params).expect("refines");
+            ((r.pose.x_m - truth.x_m).hypot(r.pose.y_m - truth.y_m), r.pitch_rad, r.rms_px)
+        };
+        let (level, _, level_rms) = error(0.0);
+        let (solved, pitch, rms) = error(0.003);
+        assert!(level > 2.0 * INCH, "a level model reads the tilt as {} in", level / INCH);
+        assert!(solved < 0.5 * INCH && (pitch - tilt).abs() < 0.001, "{} in, pitch {pitch}", solved / INCH);
+        assert!(rms < 0.2 && level_rms > rms, "rms {rms} px against {level_rms} px level");
     }
 }

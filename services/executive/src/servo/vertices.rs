@@ -17,9 +17,43 @@ pub struct RefineSetup {
     pub min_score: f64,
     /// Fixes placing the robot no better than this are refused (`mission.refine.max_sd_m`).
     pub max_sd_m: f64,
+    /// How fast dead reckoning loses the pose: the prior's growth per metre travelled.
+    pub growth: Growth,
     /// The world, to ask only for vertices in view and not hidden behind a wall; without it,
     /// every vertex is asked for.
     pub world: Option<harvey_world::World>,
+}
+
+/// How much less the believed pose is worth per metre travelled since the last fix, from the
+/// world's terrain statistics (002 §3.2 Table 3; the worst terrain of the world): the heading
+/// drifts by `drift + sd` degrees a foot (its sign unknown to the robot, as the UMS takes it), the
+/// distance falls short by `loss + sd` of itself, and the heading's drift moves the robot
+/// sideways by half of itself times the distance.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Growth {
+    pub heading_rad_per_m: f64,
+    pub along_per_m: f64,
+}
+
+impl Growth {
+    /// The worst of `world`'s terrains.
+    pub fn of(world: &harvey_world::World) -> Self {
+        let ft_per_m = 1.0 / harvey_geometry::FT;
+        world.terrain.values().fold(Self::default(), |g, t| Self {
+            heading_rad_per_m: g
+                .heading_rad_per_m
+                .max(((t.drift_deg_per_ft + t.drift_sd_deg_per_ft) * ft_per_m).to_radians()),
+            along_per_m: g.along_per_m.max(t.translational_loss_ft_per_ft + t.translational_sd_ft_per_ft),
+        })
+    }
+
+    /// `params` with its prior widened for `travelled_m` of dead reckoning.
+    pub fn widen(&self, params: &RefineParams, travelled_m: f64) -> RefineParams {
+        let heading = self.heading_rad_per_m * travelled_m;
+        let position = (self.along_per_m * travelled_m).max(heading * travelled_m / 2.0);
+        let [x, y, h] = params.prior_sd;
+        RefineParams { prior_sd: [x.hypot(position), y.hypot(position), h.hypot(heading)], ..*params }
+    }
 }
 
 /// At most this many vertices are asked for at once (the vision request queue holds 16).
