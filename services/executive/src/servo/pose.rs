@@ -233,16 +233,21 @@ mod tests {
         ]
     }
 
-    #[test]
-    fn an_expected_pose_inches_off_is_refined_to_the_true_one_despite_an_outlier() {
-        let truth = Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: 0.01 };
-        let params = RefineParams {
+    /// A loose prior, a level camera known to be level, a map taken as exact.
+    fn params() -> RefineParams {
+        RefineParams {
             prior_sd: [0.3, 0.3, 0.1],
             pitch_sd_rad: 0.0,
             image_sd_px: 0.5,
             map_sd_m: 0.0,
             gate_px: 3.0,
-        };
+        }
+    }
+
+    #[test]
+    fn an_expected_pose_inches_off_is_refined_to_the_true_one_despite_an_outlier() {
+        let truth = Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: 0.01 };
+        let params = params();
         let mut matches: Vec<VertexMatch> = vertices()
             .into_iter()
             .enumerate()
@@ -268,13 +273,7 @@ mod tests {
 
     #[test]
     fn vertices_all_at_one_depth_fix_the_position_loosely() {
-        let params = RefineParams {
-            prior_sd: [0.3, 0.3, 0.1],
-            pitch_sd_rad: 0.0,
-            image_sd_px: 0.5,
-            map_sd_m: 0.0,
-            gate_px: 3.0,
-        };
+        let params = params();
         let at = Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: 0.0 };
         let exact = |w: &[[f64; 3]]| -> Vec<VertexMatch> {
             w.iter()
@@ -329,5 +328,24 @@ mod tests {
         assert!(level > 2.0 * INCH, "a level model reads the tilt as {} in", level / INCH);
         assert!(solved < 0.5 * INCH && (pitch - tilt).abs() < 0.001, "{} in, pitch {pitch}", solved / INCH);
         assert!(rms < 0.2 && level_rms > rms, "rms {rms} px against {level_rms} px level");
+    }
+
+    #[test]
+    fn the_map_s_error_widens_the_fix_s_spread_and_a_far_jump_is_surprising() {
+        let at = Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: 0.0 };
+        let matches: Vec<VertexMatch> = vertices()
+            .into_iter()
+            .map(|w| VertexMatch { world_m: w, image_px: cam().project(at, w).expect("in front") })
+            .collect();
+        let exact = refine(&cam(), at, &matches, &params()).expect("refines");
+        let surveyed =
+            refine(&cam(), at, &matches, &RefineParams { map_sd_m: 0.01, ..params() }).expect("refines");
+        assert!((exact.map_position_sd_m - exact.position_sd_m).abs() < 1e-9, "{exact:?}");
+        assert!(surveyed.map_position_sd_m > 1.5 * surveyed.position_sd_m, "{surveyed:?}");
+        assert_eq!(surveyed.pose, exact.pose, "the map's error does not weight the matches");
+        // Expected 0.3 m and 0.1 rad off (one sd each): surprise 2; three sd off: 18.
+        let shifted = |k: f64| Pose2 { x_m: 0.3 * k, heading_rad: 0.1 * k, ..at };
+        assert!((exact.surprise(shifted(1.0), [0.3, 0.3, 0.1]) - 2.0).abs() < 0.01);
+        assert!(exact.surprise(shifted(3.0), [0.3, 0.3, 0.1]) > 16.27);
     }
 }

@@ -91,3 +91,28 @@ impl RefineSetup {
         ids
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_prior_widens_with_the_path_by_the_terrain_s_drift() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../worlds/hallway.toml");
+        let world = harvey_world::World::load(std::path::Path::new(path)).expect("world");
+        let g = Growth::of(&world);
+        let p = RefineParams {
+            prior_sd: [0.3, 0.3, 0.05],
+            pitch_sd_rad: 0.0,
+            image_sd_px: 0.5,
+            map_sd_m: 0.0,
+            gate_px: 3.0,
+        };
+        assert_eq!(g.widen(&p, 0.0), p, "no travel, no change");
+        // A 7 m leg on concrete (the worst): (0.30 + 0.14) deg/ft for 23 ft is 10 deg of heading,
+        // and 0.6 m sideways from half of it.
+        let w = g.widen(&p, 7.0);
+        assert!((w.prior_sd[2].to_degrees() - 0.05f64.to_degrees().hypot(10.1)).abs() < 0.1, "{w:?}");
+        assert!(w.prior_sd[0] > 0.6 && w.prior_sd[1] == w.prior_sd[0], "{w:?}");
+    }
+}

@@ -133,3 +133,19 @@ fn near_the_goal_it_moves_straight_or_backs_off_rather_than_turn_far() {
     let bad = PtransGoal { to: "attic".into(), ..goal() };
     assert_eq!(Monitor::new(bad, hallway()).next(BENCH, 0), Err(PlanError::UnknownLocale("attic".into())));
 }
+
+#[test]
+fn a_fixed_check_within_two_of_the_fix_s_deviations_is_reached() {
+    // The first milestone (0.15 m tolerance) checked 0.3 m off.
+    let outcome = |fix_sd_m: f64, fixed: bool| {
+        let mut m = Monitor::new(goal(), hallway());
+        let Ok(Next::Steps(_)) = m.next(BENCH, 0) else { panic!("steps") };
+        let sub = m.sketch[0].clone();
+        m.last_fix_sd(fix_sd_m);
+        m.check(&sub, BENCH, 0.3, fixed).expect("checks");
+        m.checks.last().expect("a check").outcome
+    };
+    assert_eq!(outcome(0.2, true), Outcome::Reached, "a fix good to 0.2 m cannot tell 0.3 m");
+    assert_eq!(outcome(0.1, true), Outcome::Retried);
+    assert_eq!(outcome(0.2, false), Outcome::Retried, "dead reckoning alone is taken at its word");
+}
