@@ -7,11 +7,10 @@
 mod common;
 
 use harvey_geometry::INCH;
-use harvey_msgs::{BehaviourState, TruePose};
+use harvey_msgs::{BehaviourState, Pose2, TruePose};
 
-#[test]
-fn docking_recovers_from_the_occluding_cart_and_ends_within_several_inches() {
-    let out = common::run_mission("missions/docking.toml", "docking");
+/// The behaviour's states, the acceptor's trace (each state once per visit) and the true poses.
+fn decode(out: &common::MissionRun) -> (Vec<BehaviourState>, Vec<u32>, Vec<Pose2>) {
     let (mut states, mut truth) = (Vec::new(), Vec::new());
     for m in mcap::MessageStream::new(&out.mcap).expect("mcap") {
         let m = m.expect("message");
@@ -31,9 +30,20 @@ fn docking_recovers_from_the_occluding_cart_and_ends_within_several_inches() {
             trace.push(s.fsa_state);
         }
     }
+    (states, trace, truth)
+}
+
+/// How far the run ended from the mark (in): 0.5 m out from the face's centre (13.6, 0).
+fn off_mark_in(end: Pose2) -> f64 {
+    (end.x_m - 13.1).hypot(end.y_m) / INCH
+}
+
+#[test]
+fn docking_recovers_from_the_occluding_cart_and_ends_within_several_inches() {
+    let out = common::run_mission("missions/docking.toml", "docking");
+    let (states, trace, truth) = decode(&out);
     let end = *truth.last().expect("truth");
-    // Docked: 0.5 m out from the face's centre (13.6, 0), facing it.
-    let off_in = (end.x_m - 13.1).hypot(end.y_m) / INCH;
+    let off_in = off_mark_in(end);
     println!(
         "trace {trace:?}; ends {off_in:.2} in from the mark, heading {:.2} deg",
         end.heading_rad.to_degrees()
@@ -76,4 +86,27 @@ fn docking_recovers_from_the_occluding_cart_and_ends_within_several_inches() {
     assert_eq!(common::agreed(&replay), Some(count), "{said}");
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn over_seeds_it_docks_within_several_inches() {
+    for condition in ["ideal", "nominal"] {
+        for seed in 1..=3 {
+            let out = common::run_mission_under("missions/docking.toml", condition, seed, "docks");
+            let (_, trace, truth) = decode(&out);
+            let end = *truth.last().expect("truth");
+            let off_in = off_mark_in(end);
+            println!("{condition} s{seed}: trace {trace:?}; {off_in:.2} in from the mark");
+            assert!(out.stdout.contains("goal reached"), "{condition} s{seed}: {}", out.stdout);
+            // Ballistic, then looking (recognition may fail at first, back to q0), tracked,
+            // positioned by sonar, docked.
+            assert_eq!(trace[..2], [0, 1], "{condition} s{seed}: {trace:?}");
+            assert!(trace.ends_with(&[2, 3, 4]), "{condition} s{seed}: {trace:?}");
+            // 004 §1's several inches; an inch where the map is the world.
+            let bound = if condition == "ideal" { 1.0 } else { 6.0 };
+            assert!(off_in < bound, "{condition} s{seed}: {off_in:.2} in from the mark");
+            // No heading bound here: 004 gives none, and nominal seed 2 ends 19 degrees off
+            // square (docs/evaluation.md).
+        }
+    }
 }

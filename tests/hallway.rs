@@ -18,7 +18,11 @@ struct Run {
 }
 
 fn run(mission: &str, tag: &str, steps: &str) -> Run {
-    let out = common::run_mission(mission, tag);
+    decode(common::run_mission(mission, tag), mission, steps)
+}
+
+/// A run's recording, once it is checked to have reached the goal after `steps`.
+fn decode(out: common::MissionRun, mission: &str, steps: &str) -> Run {
     assert!(
         out.status.success() && out.stdout.contains(&format!("goal reached ({steps} steps)")),
         "{mission}: {}\n{}",
@@ -94,4 +98,21 @@ fn servoing_holds_the_line_for_40_ft_where_open_loop_wanders_off_it() {
     assert!(at_18_20 > 2.0 * INCH, "open loop: {} in at 18-20 ft", at_18_20 / INCH);
     // Over the same stretch the servoed run is many times closer.
     assert!(worst(&servoed, 0.0, 20.0) * 10.0 < at_18_20);
+}
+
+#[test]
+fn over_seeds_servoing_holds_the_line_within_its_budget() {
+    for condition in ["ideal", "nominal"] {
+        for seed in 1..=3 {
+            let out = common::run_mission_under("missions/hallway-40ft.toml", condition, seed, "h40s");
+            let Run { truth, looks, .. } = decode(out, "missions/hallway-40ft.toml", "1/1");
+            let held = worst(&truth, 0.0, 40.0) / INCH;
+            println!("{condition} s{seed}: at most {held:.3} in off the line");
+            // The paper's 0.3 in where the map is the world; its 0.3 in plus the map's 0.28 in
+            // (above) under the shipped sensors.
+            let bound = if condition == "ideal" { 0.3 } else { 0.58 };
+            assert!(held <= bound, "{condition} s{seed}: {held:.3} in off the line");
+            assert_eq!(looks.len(), 21, "{condition} s{seed}");
+        }
+    }
 }

@@ -121,7 +121,6 @@ fn over_seeds_the_goal_is_reached_within_the_budget() {
             let out = common::run_mission_under("missions/ptrans.toml", condition, seed, "ptranss");
             assert!(out.stdout.contains("goal reached"), "{condition} s{seed}: {}", out.stdout);
             let off_in = final_error_in(&out.stdout);
-            let _ = std::fs::remove_dir_all(&out.dir);
             println!("{condition} s{seed}: {off_in:.2} in from the goal");
             if condition == "ideal" {
                 // 000 §5's inch, where the map is the world.
