@@ -7,6 +7,8 @@
 //! they live at the workspace's root, not in any one service.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
+#[path = "../common/docked.rs"]
+mod docked;
 mod docking;
 mod launch;
 mod plan;

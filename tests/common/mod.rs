@@ -2,6 +2,8 @@
 //! scratch folder unique to each test, and checks that nothing is left behind.
 #![allow(dead_code)]
 
+pub mod docked;
+
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
 use std::sync::atomic::{AtomicU32, Ordering};
