@@ -6,7 +6,7 @@ use iceoryx2_bb_elementary_traits::zero_copy_send::ZeroCopySend;
 
 /// A planar pose: position in metres and heading in radians (counter-clockwise from +x). As a
 /// transform `a_from_b`, it maps coordinates in frame `b` into frame `a`.
-#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 #[type_name("harvey_msgs/Pose2")]
 pub struct Pose2 {

@@ -3,7 +3,7 @@
 //! one seed gives one run on every machine.
 
 /// Seeded generator; the same seed yields the same sequence on every machine.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Rng {
     state: u64,
 }

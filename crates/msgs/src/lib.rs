@@ -21,7 +21,7 @@ pub use vision::*;
 
 /// The header every message starts with: a per-publisher sequence number and the time the
 /// message is about (simulated or sensor time, never the wall clock of the publisher).
-#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, ZeroCopySend)]
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 #[type_name("harvey_msgs/Header")]
 pub struct Header {

@@ -116,7 +116,7 @@ impl CommandKind {
 }
 
 /// A motion command for the vehicle (`vehicle/command`).
-#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 #[type_name("harvey_msgs/MotionCommand")]
 pub struct MotionCommand {

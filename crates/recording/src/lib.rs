@@ -18,6 +18,7 @@
 //! offset and the [`Damage`], never a panic or an allocation of what a flipped bit claims.
 
 mod attachments;
+pub mod carry_over;
 mod chunk;
 pub mod compare;
 mod damage;

@@ -117,6 +117,11 @@ impl Recorder {
         self.add_channel(topic, T::DEF)
     }
 
+    /// The channel set up for `topic`, if any.
+    pub fn channel_of(&self, topic: &str) -> Option<Channel> {
+        self.channels.iter().position(|(_, s)| s.topic == topic).map(Channel)
+    }
+
     /// A channel of `sensor_msgs/msg/Image` for a frame topic.
     pub fn image_channel(&mut self, topic: &str) -> Result<Channel, RecordingError> {
         self.add_channel(topic, image_def())

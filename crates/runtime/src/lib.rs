@@ -1,9 +1,15 @@
-//! What every Harvey service process shares: logging set-up and the readiness handshake with
-//! the supervisor.
+//! What every Harvey service process shares: logging set-up, the readiness handshake with
+//! the supervisor, and [`checkpoint`]s of a service's state across restarts.
 //!
 //! Readiness: the supervisor passes a pipe's write end in `$HARVEY_READY_FD`; a service calls
 //! [`notify_ready`] once its ports exist, which writes `READY\n` and closes the pipe. A service
 //! started by hand (no variable) skips the handshake.
+
+pub mod checkpoint;
+pub mod resume;
+
+pub use checkpoint::{Checkpoint, CheckpointError, STATE_DIR_ENV};
+pub use resume::Resume;
 
 use std::io::Write;
 use std::os::fd::FromRawFd;

@@ -17,6 +17,8 @@ pub const MIN_GRACE_MS: u64 = 200;
 /// The longest any wait of the launch file may be (grace, readiness): ten minutes. Larger
 /// values only hang a launch, and `u64::MAX` ms overflows the clock's instants.
 pub const MAX_WAIT_MS: u64 = 600_000;
+/// The longest wall-clock limit of a launch: a week (a real robot's long run).
+pub const MAX_WALL_S: u64 = 604_800;
 /// The longest restart window: a week. Longer windows never forget a failure in any launch.
 pub const MAX_WINDOW_S: f64 = 604_800.0;
 /// Restarts a window may allow (each keeps an instant).
@@ -68,7 +70,8 @@ fn int(
 /// The `[launch]` numbers in range.
 pub(crate) fn check_settings(s: &Settings) -> Result<(), Refused> {
     int(None, "grace_period_ms", s.grace_period_ms, MIN_GRACE_MS, MAX_WAIT_MS, "ms")?;
-    int(None, "ready_timeout_ms", s.ready_timeout_ms, 1, MAX_WAIT_MS, "ms")
+    int(None, "ready_timeout_ms", s.ready_timeout_ms, 1, MAX_WAIT_MS, "ms")?;
+    int(None, "wall_limit_s", s.wall_limit_s, 1, MAX_WALL_S, "s")
 }
 
 /// The numbers of the `[[service]]` at `i` in range.

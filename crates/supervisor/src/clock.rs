@@ -6,8 +6,9 @@ use std::time::{Duration, Instant};
 use harvey_bus::{Bus, BusError, Publisher, Subscriber};
 use harvey_msgs::{Header, Progress, topics};
 
-/// How long the chain may stand still before the supervisor names the party it waits for.
-const STALL_WARNING: Duration = Duration::from_secs(10);
+/// How long the chain may stand still before the supervisor names the party it waits for, and
+/// how often it says so again while the stall lasts.
+const STALL_WARNING: Duration = Duration::from_secs(5);
 
 struct Party {
     name: String,
@@ -21,7 +22,8 @@ struct Party {
 pub struct ClockWatch {
     parties: Vec<Party>,
     moved_at: Instant,
-    warned: bool,
+    /// When the stall was last reported.
+    warned_at: Option<Instant>,
     _bus: Bus,
 }
 
@@ -41,7 +43,7 @@ impl ClockWatch {
                 })
             })
             .collect::<Result<Vec<_>, BusError>>()?;
-        Ok(Self { parties, moved_at: Instant::now(), warned: false, _bus: bus })
+        Ok(Self { parties, moved_at: Instant::now(), warned_at: None, _bus: bus })
     }
 
     /// Starts the chain: the tail "has finished" tick 0, so the master begins tick 1.
@@ -54,30 +56,32 @@ impl ClockWatch {
         Ok(())
     }
 
-    /// Takes in the parties' progress; warns once when the chain has not moved for a while.
+    /// Takes in the parties' progress; while the chain stands still, says every few seconds
+    /// which party it waits for.
     pub fn poll(&mut self) -> Result<(), BusError> {
         for p in &mut self.parties {
             if let Some(m) = p.progress.latest()? {
                 p.last = Some(m.header.stamp_ns);
                 self.moved_at = Instant::now();
-                self.warned = false;
+                self.warned_at = None;
             }
         }
-        if !self.warned && self.moved_at.elapsed() > STALL_WARNING {
-            self.warned = true;
+        let due = self.warned_at.map_or(self.moved_at, |w| w) + STALL_WARNING;
+        if Instant::now() >= due {
+            self.warned_at = Some(Instant::now());
             let (waiting, tick) = self.holder();
             tracing::warn!(
                 party = %waiting,
                 tick_ms = tick / 1_000_000,
                 "deterministic clock has not moved for {} s: waiting for `{waiting}`",
-                STALL_WARNING.as_secs()
+                self.moved_at.elapsed().as_secs()
             );
         }
         Ok(())
     }
 
     /// The party whose turn it is, and the last tick its predecessor finished.
-    fn holder(&self) -> (&str, u64) {
+    pub fn holder(&self) -> (&str, u64) {
         let newest = self.parties.iter().filter_map(|p| p.last).max().unwrap_or(0);
         let n = self.parties.len();
         for i in 0..n {
@@ -90,14 +94,18 @@ impl ClockWatch {
     }
 
     /// After `party` restarted: if its predecessor finished a tick it had not, hand the restarted
-    /// party that turn again (its earlier self took the notice with it).
+    /// party that turn again (its earlier self took the notice with it). The clock master's turn
+    /// is the tick the tail finished, which is the master's own last one: it gets that tick
+    /// again whenever the tail has caught up with it (the master, the bridge, tells a repeat
+    /// from news).
     pub fn resume(&mut self, party: &str) -> Result<(), BusError> {
         self.poll()?;
         let n = self.parties.len();
         let Some(i) = self.parties.iter().position(|p| p.name == party) else { return Ok(()) };
         let pred = &self.parties[(i + n - 1) % n];
+        let behind = |own: u64, t: u64| if i == 0 { own <= t } else { own < t };
         if let Some(t) = pred.last
-            && self.parties[i].last.is_none_or(|own| own < t)
+            && self.parties[i].last.is_none_or(|own| behind(own, t))
         {
             pred.stand_in.send(&Progress { header: Header::new(0, t) })?;
             tracing::warn!(party, tick_ms = t / 1_000_000, "deterministic clock resumed after a restart");

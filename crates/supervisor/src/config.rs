@@ -26,6 +26,10 @@ pub struct Settings {
     pub grace_period_ms: u64,
     #[serde(default = "default_ready_ms")]
     pub ready_timeout_ms: u64,
+    /// The longest the launch may run by the wall clock: a mission's own timeout counts
+    /// simulated time, which stands still when the clock chain stalls; this ends even that.
+    #[serde(default = "default_wall_limit_s")]
+    pub wall_limit_s: u64,
     /// `lockstep` (deterministic: ticks advance when every party has finished the last one) or
     /// `realtime` (paced by the wall clock, for a real robot).
     #[serde(default)]
@@ -65,6 +69,10 @@ fn default_grace_ms() -> u64 {
 }
 fn default_ready_ms() -> u64 {
     10_000
+}
+/// Half an hour: the longest shipped mission takes a few minutes of wall time on two cores.
+fn default_wall_limit_s() -> u64 {
+    1800
 }
 fn default_restart() -> Restart {
     Restart::OnFailure

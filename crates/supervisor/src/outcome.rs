@@ -11,6 +11,8 @@ pub enum Outcome {
     Interrupted,
     /// A service failed more often than its policy allows.
     GaveUp { service: String },
+    /// The launch ran past its wall-clock limit (`[launch] wall_limit_s`).
+    WallLimit { limit_s: u64 },
 }
 
 impl Outcome {
@@ -20,6 +22,8 @@ impl Outcome {
             Outcome::Ended { code, .. } => *code,
             Outcome::Interrupted => 130,
             Outcome::GaveUp { .. } => 1,
+            // As timeout(1) exits.
+            Outcome::WallLimit { .. } => 124,
         }
     }
 }

@@ -32,6 +32,9 @@ impl Slot {
     }
 }
 
+/// The run folder's folder of the services' checkpoints (`harvey_runtime::checkpoint`).
+pub const STATE_DIR: &str = "state";
+
 /// Finds a service's executable: a path as given, else beside this program, else on `PATH`.
 pub fn find_binary(name: &str) -> Option<PathBuf> {
     if name.contains('/') {
@@ -59,6 +62,13 @@ fn absolute(p: &Path) -> PathBuf {
 pub fn prepare(launch: &LaunchFile, opts: &Options, chain: &[String]) -> Result<Vec<Slot>, SupervisorError> {
     std::fs::create_dir_all(&opts.run_dir)
         .map_err(|source| SupervisorError::RunDir { path: opts.run_dir.clone(), source })?;
+    // The services' checkpoints: a fresh launch starts from nothing, a restart from its own.
+    let state_dir = opts.run_dir.join(STATE_DIR);
+    let fresh = match std::fs::remove_dir_all(&state_dir) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
+        _ => std::fs::create_dir_all(&state_dir),
+    };
+    fresh.map_err(|source| SupervisorError::RunDir { path: state_dir.clone(), source })?;
     let mut vars = vec![
         ("run_dir", absolute(&opts.run_dir).display().to_string()),
         ("seed", launch.settings.seed.to_string()),
@@ -78,6 +88,7 @@ pub fn prepare(launch: &LaunchFile, opts: &Options, chain: &[String]) -> Result<
         let mut env = vec![
             (harvey_bus::PREFIX_ENV, opts.prefix.clone()),
             (harvey_bus::CLOCK_ENV, clock_mode.to_owned()),
+            (harvey_runtime::STATE_DIR_ENV, absolute(&state_dir).display().to_string()),
         ];
         if let Some(i) = chain.iter().position(|p| p == s.name()) {
             let after = &chain[(i + chain.len() - 1) % chain.len()];

@@ -33,7 +33,14 @@ pub fn supervise(
     signals: &Signals,
 ) -> Result<Outcome, SupervisorError> {
     let end_with = launch.settings.end_with.as_ref().map(|s| s.get_ref().clone());
+    let limit_s = launch.settings.wall_limit_s;
+    let deadline = Instant::now() + Duration::from_secs(limit_s);
     loop {
+        if Instant::now() >= deadline {
+            let waiting = clock.as_deref().map(|c| c.holder().0.to_owned());
+            tracing::error!(limit_s, waiting = ?waiting, "the launch ran past its wall-clock limit: stopping");
+            return Ok(Outcome::WallLimit { limit_s });
+        }
         if let Some(c) = clock.as_deref_mut() {
             c.poll()?;
         }

@@ -2,8 +2,10 @@
 //! checks), DRV reports become SI messages for the bus. The only place that knows DRV units.
 //! [`watchdog`] stops the vehicle when the executive falls silent.
 
+pub mod resume;
 pub mod watchdog;
 
+pub use resume::{BridgeState, Source};
 pub use watchdog::{SHUTDOWN_STOP_ID, WATCHDOG_STOP_ID, Watchdog};
 
 use harvey_drv_protocol::{Command, NakReason, Report};
@@ -36,7 +38,7 @@ pub enum Refusal {
 /// panic-avoid's), so that no old or new motion command slips in while the sonar keeps
 /// reporting the obstacle ahead (it re-sends the stop with every ring). Turning on the spot and
 /// backing away are let through: without them a robot stopped before a wall would stay there.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct PanicLatch {
     hold_ns: u64,
     until_ns: Option<u64>,
@@ -145,7 +147,7 @@ pub enum Outgoing {
 }
 
 /// Report → message converter; numbers each output topic's messages.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct Bridge {
     encoder_seq: u64,
     sonar_seq: u64,

@@ -1,19 +1,22 @@
 //! harvey-denning-bridge: connects a DRV serial line (a real port, or the simulated DRV's
-//! pseudo-terminal) to the bus.
+//! pseudo-terminal) to the bus. It reopens a line that hangs up, and keeps its state in a
+//! checkpoint, so that neither its own restart nor the DRV's loses or repeats a message.
 
 use std::fs::{File, OpenOptions};
 use std::os::unix::fs::OpenOptionsExt;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, FdSource, Lockstep, Publisher, Subscriber, Waiter, Wake};
 use harvey_denning_bridge::{
-    Bridge, Outgoing, PanicLatch, SHUTDOWN_STOP_ID, WATCHDOG_STOP_ID, Watchdog, prioritise, to_drv,
+    BridgeState, Outgoing, SHUTDOWN_STOP_ID, Source, WATCHDOG_STOP_ID, prioritise, to_drv,
 };
 use harvey_drv_protocol::serial::{make_raw, read_available, write_frame};
 use harvey_drv_protocol::{Command, Decoder, Line, encode};
 use harvey_msgs::{EncodersRaw, MissionStatus, MotionCommand, SonarRaw, topics};
+use harvey_runtime::Checkpoint;
 
 #[derive(Parser)]
 #[command(about = "Bridge between a Denning DRV serial line and the Harvey bus")]
@@ -28,18 +31,20 @@ struct Args {
     /// this long (vehicle time, from the DRV's reports), and on shutdown.
     #[arg(long, default_value_t = 200)]
     watchdog_ms: u64,
+    /// When the line hangs up (or is not there yet), keep trying to open it for this long
+    /// before giving up.
+    #[arg(long, default_value_t = 10.0)]
+    reopen_s: f64,
 }
+
+/// Room for the bridge's state and a round's lines.
+const SLOT_BYTES: usize = 16 << 10;
 
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
-    let mut port = OpenOptions::new()
-        .read(true)
-        .write(true)
-        .custom_flags(nix::libc::O_NOCTTY | nix::libc::O_NONBLOCK)
-        .open(&args.device)
-        .with_context(|| format!("opening DRV serial device {}", args.device.display()))?;
-    make_raw(&port).with_context(|| format!("setting {} to raw mode", args.device.display()))?;
+    let reopen_for = Duration::from_secs_f64(args.reopen_s.max(0.0));
+    let port = open_line(&args.device, reopen_for)?;
 
     let bus = Bus::join("denning-bridge")?;
     let ports = Ports {
@@ -54,27 +59,100 @@ fn main() -> anyhow::Result<()> {
     // the DRV's `TK` closes its reports; when the chain's tail has finished the tick, the
     // tick's commands go out, closed by `SY`.
     let lockstep = Lockstep::from_env(&bus)?;
+    let mut checkpoint = Checkpoint::from_env("denning-bridge", SLOT_BYTES)?;
+    let restored = checkpoint.as_mut().map(|c| c.load::<BridgeState>()).transpose()?.flatten();
+    let mut resumed = restored.is_some();
+    let mut state = restored
+        .unwrap_or_else(|| BridgeState::new(args.panic_hold_ms * 1_000_000, args.watchdog_ms * 1_000_000));
+    if resumed {
+        tracing::warn!(synced_ms = ?state.synced, "resumed from the checkpoint");
+    }
     let waiter = Waiter::new()?;
-    let line_source = FdSource::new(&port)?;
-    let _a = match &lockstep {
-        Some(l) => waiter.attach(l.predecessor())?,
-        None => waiter.attach(&ports.commands)?,
-    };
-    let _b = waiter.attach(&line_source)?;
-    // Real time: a reflex's command wakes the bridge too (in lockstep the chain's turn does).
-    let _c = match &lockstep {
-        Some(_) => None,
-        None => Some((waiter.attach(&ports.reflexes)?, waiter.attach(&ports.heartbeat)?)),
-    };
     harvey_runtime::notify_ready()?;
     tracing::info!(device = %args.device.display(), lockstep = lockstep.is_some(), "bridge up");
 
-    let mut watchdog = Watchdog::new(args.watchdog_ms * 1_000_000);
-    let result = run(&args, &mut port, &lockstep, &waiter, &ports, &mut watchdog);
+    let mut link = Link { port, state: &mut state, checkpoint: checkpoint.as_mut() };
+    let result = loop {
+        // After a hang-up or a restart the DRV may have missed the last round: it goes again
+        // (the DRV answers a round it has already run with that tick's lines, which the bridge
+        // then drops as repeats).
+        if resumed && lockstep.is_some() {
+            for frame in link.state.round.clone() {
+                link.send_raw(&frame)?;
+            }
+        }
+        match run(&args, &mut link, &lockstep, &waiter, &ports) {
+            Ok(Ended::Shutdown) => break Ok(()),
+            Ok(Ended::HungUp) => {
+                tracing::warn!(device = %args.device.display(), "the DRV line hung up: reopening");
+                match open_line(&args.device, reopen_for) {
+                    Ok(p) => link.port = p,
+                    Err(e) => break Err(e),
+                }
+                resumed = true;
+            }
+            Err(e) => break Err(e),
+        }
+    };
     // Whatever ended the loop (a shutdown, an error), the vehicle stops before the bridge goes.
-    let stop = send(&mut port, &Line::Command(Command::Stop { id: SHUTDOWN_STOP_ID }));
+    let stop = send(&mut link.port, &Line::Command(Command::Stop { id: SHUTDOWN_STOP_ID }));
     tracing::info!(sent = stop.is_ok(), "stop sent on the way out");
     result
+}
+
+/// Opens the DRV's line, waiting up to `wait` for it to appear (a simulated DRV re-creating its
+/// terminal, a USB adapter coming back).
+fn open_line(device: &Path, wait: Duration) -> anyhow::Result<File> {
+    let deadline = Instant::now() + wait;
+    loop {
+        let opened = OpenOptions::new()
+            .read(true)
+            .write(true)
+            .custom_flags(nix::libc::O_NOCTTY | nix::libc::O_NONBLOCK)
+            .open(device);
+        match opened {
+            Ok(port) => {
+                make_raw(&port).with_context(|| format!("setting {} to raw mode", device.display()))?;
+                return Ok(port);
+            }
+            Err(_) if Instant::now() < deadline => std::thread::sleep(REOPEN_POLL),
+            Err(e) => {
+                return Err(e).with_context(|| format!("opening DRV serial device {}", device.display()));
+            }
+        }
+    }
+}
+
+/// How often a missing line is tried again.
+const REOPEN_POLL: Duration = Duration::from_millis(20);
+
+/// Why the loop over one connection ended.
+enum Ended {
+    Shutdown,
+    HungUp,
+}
+
+/// The line and the state that outlives it.
+struct Link<'a> {
+    port: File,
+    state: &'a mut BridgeState,
+    checkpoint: Option<&'a mut Checkpoint>,
+}
+
+impl Link<'_> {
+    fn save(&mut self) -> anyhow::Result<()> {
+        match self.checkpoint.as_deref_mut() {
+            Some(c) => Ok(c.save(&*self.state)?),
+            None => Ok(()),
+        }
+    }
+
+    fn send_raw(&mut self, frame: &str) -> anyhow::Result<()> {
+        if !write_frame(&mut self.port, frame.as_bytes())? {
+            tracing::error!(frame, "serial line full: frame not sent");
+        }
+        Ok(())
+    }
 }
 
 /// The bus ports of the bridge.
@@ -86,37 +164,64 @@ struct Ports {
     sonar: Publisher<SonarRaw>,
 }
 
-/// The bridge's loop, until shutdown.
+/// Sends the commands that arrived (each once, across restarts); in lockstep the round's lines
+/// are kept to send again. True if any came from the executive.
+fn forward(
+    link: &mut Link,
+    ports: &Ports,
+    batch: &mut Vec<MotionCommand>,
+    round: &mut Vec<String>,
+) -> anyhow::Result<bool> {
+    batch.clear();
+    // The reflexes' commands first: an urgent stop among them pre-empts the batch.
+    ports.reflexes.drain(|c| batch.push(*c))?;
+    let reflexes = batch.len();
+    ports.commands.drain(|c| batch.push(*c))?;
+    let executive = batch.len() > reflexes;
+    let mut i = 0;
+    batch.retain(|c| {
+        let source = if i < reflexes { Source::Reflexes } else { Source::Commands };
+        i += 1;
+        link.state.fresh_command(source, c)
+    });
+    for cmd in prioritise(batch) {
+        match link.state.latch.admit(&cmd).and_then(|()| to_drv(&cmd)) {
+            Ok(drv) => {
+                let frame = encode(&Line::Command(drv));
+                link.send_raw(&frame)?;
+                round.push(frame);
+            }
+            Err(refusal) => tracing::error!("refused: {refusal}"),
+        }
+    }
+    Ok(executive)
+}
+
+/// The bridge's loop over one connection, until shutdown or the line hangs up.
 fn run(
     args: &Args,
-    port: &mut File,
+    link: &mut Link,
     lockstep: &Option<Lockstep>,
     waiter: &Waiter,
     ports: &Ports,
-    watchdog: &mut Watchdog,
-) -> anyhow::Result<()> {
-    let mut bridge = Bridge::default();
-    let mut latch = PanicLatch::new(args.panic_hold_ms * 1_000_000);
-    let mut decoder = Decoder::new();
-    let (mut buf, mut batch, mut ticks) = (Vec::new(), Vec::new(), Vec::new());
-    // Sends the commands that arrived; true if any came from the executive.
-    let mut forward = |port: &mut File| -> anyhow::Result<bool> {
-        batch.clear();
-        // The reflexes' commands first: an urgent stop among them pre-empts the batch.
-        ports.reflexes.drain(|c| batch.push(*c))?;
-        let reflexes = batch.len();
-        ports.commands.drain(|c| batch.push(*c))?;
-        for cmd in prioritise(&batch) {
-            match latch.admit(&cmd).and_then(|()| to_drv(&cmd)) {
-                Ok(drv) => send(port, &Line::Command(drv))?,
-                Err(refusal) => tracing::error!("refused: {refusal}"),
-            }
-        }
-        Ok(batch.len() > reflexes)
+) -> anyhow::Result<Ended> {
+    let line_source = FdSource::new(&link.port)?;
+    let _a = match lockstep {
+        Some(l) => waiter.attach(l.predecessor())?,
+        None => waiter.attach(&ports.commands)?,
     };
+    let _b = waiter.attach(&line_source)?;
+    // Real time: a reflex's command wakes the bridge too (in lockstep the chain's turn does).
+    let _c = match lockstep {
+        Some(_) => None,
+        None => Some((waiter.attach(&ports.reflexes)?, waiter.attach(&ports.heartbeat)?)),
+    };
+    let mut decoder = Decoder::new();
+    let (mut buf, mut batch, mut ticks, mut round) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     loop {
         if waiter.wait(None)? == Wake::Shutdown {
-            break;
+            tracing::info!(stats = ?decoder.stats(), "bridge stopped");
+            return Ok(Ended::Shutdown);
         }
         let beats = ports.heartbeat.drain(|_| {})?;
         let mut commanded = false;
@@ -125,70 +230,101 @@ fn run(
                 ticks.clear();
                 l.finished(|t| ticks.push(t))?;
                 for &t in &ticks {
-                    commanded |= forward(port)?;
-                    send(port, &Line::Sync { time_ms: t / 1_000_000 })?;
+                    let t_ms = t / 1_000_000;
+                    if !link.state.needs_sync(t_ms) {
+                        continue;
+                    }
+                    round.clear();
+                    commanded |= forward(link, ports, &mut batch, &mut round)?;
+                    let sync = encode(&Line::Sync { time_ms: t_ms });
+                    round.push(sync.clone());
+                    (link.state.synced, link.state.round) = (Some(t_ms), std::mem::take(&mut round));
+                    link.save()?;
+                    link.send_raw(&sync)?;
                 }
             }
-            None => commanded = forward(port)?,
+            None => {
+                commanded = forward(link, ports, &mut batch, &mut round)?;
+                round.clear();
+            }
         }
         if beats > 0 || commanded {
-            watchdog.heartbeat();
+            link.state.watchdog.heartbeat();
             // Real time: the DRV's own watchdog hears of the executive from the bridge (in
             // lockstep every tick's `SY` feeds it).
             if lockstep.is_none() {
-                send(port, &Line::Heartbeat { time_ms: watchdog.now_ms() })?;
+                let now_ms = link.state.watchdog.now_ms();
+                send(&mut link.port, &Line::Heartbeat { time_ms: now_ms })?;
             }
         }
-        if !read_available(port, &mut buf).context("reading the DRV line")? {
-            anyhow::bail!("the DRV line {} hung up", args.device.display());
+        if !read_available(&mut link.port, &mut buf).context("reading the DRV line")? {
+            return Ok(Ended::HungUp);
         }
-        let mut out = Vec::new();
+        let mut lines = Vec::new();
         decoder.push(&buf, |frame| match frame {
-            Ok(Line::Report(r)) => out.push(bridge.on_report(r)),
-            Ok(Line::Tick { time_ms }) => out.push(Outgoing::Tick { time_ms }),
-            Ok(line @ (Line::Command(_) | Line::Sync { .. } | Line::Heartbeat { .. })) => {
-                tracing::warn!(?line, "ignoring a host frame echoed by the vehicle")
-            }
+            Ok(line) => lines.push(line),
             Err(e) => tracing::warn!("bad frame from the DRV: {e}"),
         });
-        for o in out {
-            let stamp_ns = match o {
-                Outgoing::Encoders(m) => {
-                    ports.encoders.send(&m)?;
-                    Some(m.header.stamp_ns)
-                }
-                Outgoing::Sonar(m) => {
-                    ports.sonar.send(&m)?;
-                    Some(m.header.stamp_ns)
-                }
-                Outgoing::Tick { time_ms } => {
-                    match lockstep {
-                        Some(l) => l.finish(time_ms * 1_000_000)?,
-                        None => tracing::warn!(time_ms, "a tick mark from the DRV in real-time mode"),
-                    }
-                    None
-                }
-                Outgoing::Refused { id, reason } => {
-                    tracing::error!(id, ?reason, "the DRV refused a command");
-                    None
-                }
-                Outgoing::Accepted { id } => {
-                    tracing::debug!(id, "the DRV accepted a command");
-                    None
-                }
-            };
-            if stamp_ns.is_some_and(|t| watchdog.on_vehicle_time(t)) {
-                tracing::error!(
-                    deadline_ms = args.watchdog_ms,
-                    vehicle_ms = watchdog.now_ms(),
-                    "no heartbeat from the executive: stopping the vehicle"
-                );
-                send(port, &Line::Command(Command::Stop { id: WATCHDOG_STOP_ID }))?;
+        for line in lines {
+            if !link.state.fresh_from_drv(&line) {
+                tracing::debug!(?line, "a repeat of a line already published");
+                continue;
             }
+            publish(args, link, lockstep, ports, line)?;
         }
     }
-    tracing::info!(stats = ?decoder.stats(), "bridge stopped");
-    Ok(())
+}
+
+/// Puts one line from the DRV on the bus.
+fn publish(
+    args: &Args,
+    link: &mut Link,
+    lockstep: &Option<Lockstep>,
+    ports: &Ports,
+    line: Line,
+) -> anyhow::Result<()> {
+    let out = match line {
+        Line::Report(r) => link.state.bridge.on_report(r),
+        Line::Tick { time_ms } => Outgoing::Tick { time_ms },
+        line @ (Line::Command(_) | Line::Sync { .. } | Line::Heartbeat { .. }) => {
+            tracing::warn!(?line, "ignoring a host frame echoed by the vehicle");
+            return Ok(());
+        }
+    };
+    let stamp_ns = match out {
+        Outgoing::Encoders(m) => {
+            ports.encoders.send(&m)?;
+            Some(m.header.stamp_ns)
+        }
+        Outgoing::Sonar(m) => {
+            ports.sonar.send(&m)?;
+            Some(m.header.stamp_ns)
+        }
+        Outgoing::Tick { time_ms } => {
+            match lockstep {
+                Some(l) => l.finish(time_ms * 1_000_000)?,
+                None => tracing::warn!(time_ms, "a tick mark from the DRV in real-time mode"),
+            }
+            None
+        }
+        Outgoing::Refused { id, reason } => {
+            tracing::error!(id, ?reason, "the DRV refused a command");
+            None
+        }
+        Outgoing::Accepted { id } => {
+            tracing::debug!(id, "the DRV accepted a command");
+            None
+        }
+    };
+    if stamp_ns.is_some_and(|t| link.state.watchdog.on_vehicle_time(t)) {
+        tracing::error!(
+            deadline_ms = args.watchdog_ms,
+            vehicle_ms = link.state.watchdog.now_ms(),
+            "no heartbeat from the executive: stopping the vehicle"
+        );
+        send(&mut link.port, &Line::Command(Command::Stop { id: WATCHDOG_STOP_ID }))?;
+    }
+    link.save()
 }
 
 /// Writes one frame to the DRV; a full line loses it, loudly.

@@ -11,7 +11,7 @@ pub const SHUTDOWN_STOP_ID: u32 = u32::MAX - 1;
 /// Watches the executive's heartbeat (its status, or any command from it) against a deadline
 /// of vehicle time. It counts from the first heartbeat only (the executive may start after the
 /// vehicle), and asks for one stop per lapse; the next heartbeat re-arms it.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct Watchdog {
     deadline_ns: u64,
     /// The vehicle's time: the stamp of the latest DRV report.

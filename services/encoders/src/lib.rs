@@ -15,7 +15,7 @@ pub enum EncoderError {
 }
 
 /// Odometry state: the last command and where the encoders stood when the DRV accepted it.
-#[derive(Debug, Default)]
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct OdometryBuilder {
     command: MotionCommand,
     /// Encoder pose just before the current command took effect.

@@ -1,8 +1,14 @@
-//! harvey-encoders: DRV shaft-encoder reports and motion commands in, odometry out.
+//! harvey-encoders: DRV shaft-encoder reports and motion commands in, odometry out. Its state
+//! (the command under way and where it started) is checkpointed at every tick, so a restarted
+//! encoders service goes on with the same command and neither loses nor repeats a message.
 
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_encoders::OdometryBuilder;
-use harvey_msgs::topics;
+use harvey_msgs::{Message, topics};
+use harvey_runtime::Resume;
+
+/// Room for the builder and the marks of three inputs and one output.
+const SLOT_BYTES: usize = 4 << 10;
 
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
@@ -14,24 +20,38 @@ fn main() -> anyhow::Result<()> {
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&raw, &commands, &reflexes])?;
+    let mut resume = Resume::from_env("encoders", SLOT_BYTES, OdometryBuilder::default)?;
+    if resume.resumed() {
+        tracing::warn!("resumed from the checkpoint");
+    }
     harvey_runtime::notify_ready()?;
 
-    let mut builder = OdometryBuilder::default();
     let (mut reports, mut cmds) = (Vec::new(), Vec::new());
+    let fresh = |resume: &mut Resume<OdometryBuilder>, topic: &str, msgs: &mut Vec<_>| {
+        msgs.retain(|m: &harvey_msgs::MotionCommand| {
+            resume.fresh(topic, m.header().stamp_ns, m.header().seq)
+        });
+    };
     while pace.next(&waiter, None)? != Step::Stop {
         commands.drain_into(&mut cmds)?;
-        cmds.iter().for_each(|c| builder.on_command(c));
+        fresh(&mut resume, commands.topic(), &mut cmds);
+        cmds.iter().for_each(|c| resume.state().on_command(c));
         reflexes.drain_into(&mut cmds)?;
-        cmds.iter().for_each(|c| builder.on_command(c));
+        fresh(&mut resume, reflexes.topic(), &mut cmds);
+        cmds.iter().for_each(|c| resume.state().on_command(c));
         raw.drain_into(&mut reports)?;
+        reports.retain(|r| resume.fresh(raw.topic(), r.header.stamp_ns, r.header.seq));
         for r in &reports {
-            match builder.on_encoders(r) {
+            match resume.state().on_encoders(r) {
                 Ok(odo) => {
-                    odometry.send(&odo)?;
+                    if resume.send_due(odometry.topic(), odo.header.stamp_ns, odo.header.seq)? {
+                        odometry.send(&odo)?;
+                    }
                 }
                 Err(e) => tracing::warn!("dropping an encoder report: {e}"),
             }
         }
+        resume.tick_done()?;
         pace.done()?;
     }
     Ok(())

@@ -1,8 +1,9 @@
 //! harvey-recorder: subscribes to every topic and writes them to `run.mcap` (and, with `--rrd`,
 //! draws them into a Rerun file). In real time it never slows a publisher (its queues overwrite
 //! when full; the gaps are counted); in deterministic mode it is the clock chain's tail and
-//! records every tick whole. It flushes at least every second and finishes the files on
-//! SIGINT/SIGTERM.
+//! records every tick whole. It flushes at least every `--flush-ms` and finishes the files on
+//! SIGINT/SIGTERM. Restarted under the supervisor, it continues the recording it was writing
+//! (`harvey_recording::carry_over`): one file, less only what was not yet flushed.
 
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
@@ -12,8 +13,9 @@ use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waitable, Waiter};
 use harvey_cdr::Ros2Msg;
 use harvey_msgs::{Message, Topic, topics};
+use harvey_recording::draw::draw_recorded;
 use harvey_recording::rrd::RrdWriter;
-use harvey_recording::{ChunkCompression, Recorder, data_files};
+use harvey_recording::{ChunkCompression, Recorder, carry_over, data_files};
 
 mod taps;
 mod writer;
@@ -53,6 +55,12 @@ struct Args {
     compression: Compression,
 }
 
+/// What the recorder's checkpoint says: a recording of this run is under way.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Started {
+    recording: bool,
+}
+
 /// `--compression`'s values.
 #[derive(Clone, Copy, clap::ValueEnum)]
 enum Compression {
@@ -81,6 +89,10 @@ fn tap<T: Message + Ros2Msg>(bus: &Bus, rec: &mut Recorder, topic: Topic<T>) -> 
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
+    // A checkpoint says this run's recording is under way: a restart continues it.
+    let mut checkpoint = harvey_runtime::Checkpoint::from_env("recorder", 4 << 10)?;
+    let restarted = checkpoint.as_mut().map(|c| c.load::<Started>()).transpose()?.flatten().is_some();
+    let interrupted = if restarted { carry_over::set_aside(&args.output)? } else { None };
     let mut rec = Recorder::create_with(&args.output, args.compression.into())?;
     let world = match &args.world {
         Some(path) => {
@@ -105,7 +117,7 @@ fn main() -> anyhow::Result<()> {
             rec.attach_data(&file, &bytes)?;
         }
     }
-    let rrd = args.rrd.as_ref().map(|p| RrdWriter::create(p, world.as_ref())).transpose()?;
+    let mut rrd = args.rrd.as_ref().map(|p| RrdWriter::create(p, world.as_ref())).transpose()?;
     let bus = Bus::join("recorder")?;
     let frame_channel = rec.image_channel(topics::CAMERA_FRAME.name)?;
     let taps: Vec<Box<dyn Tap>> = vec![
@@ -132,19 +144,32 @@ fn main() -> anyhow::Result<()> {
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();
     let missing: Vec<&&str> = topics::ALL.iter().filter(|t| !recorded.contains(t)).collect();
     anyhow::ensure!(missing.is_empty(), "the recorder has no tap for {missing:?}");
+    if let Some(old) = &interrupted {
+        let carried = carry_over::carry_over(old, &mut rec, |topic, data| -> anyhow::Result<()> {
+            if let Some(rrd) = rrd.as_mut() {
+                draw_recorded(rrd, topic, data).map_err(|e| anyhow::anyhow!("drawing {topic}: {e}"))?;
+            }
+            Ok(())
+        })?;
+        tracing::warn!(messages = carried.messages, damaged_chunks = ?carried.damaged_chunks, from = %old.display(), "continuing the recording a killed recorder left");
+    }
+    if let Some(c) = checkpoint.as_mut() {
+        c.save(&Started { recording: true })?;
+    }
     let pace = Pace::from_env(&bus)?;
     let lockstep = pace.lockstep().is_some();
     let waiter = Waiter::new()?;
     let waitables: Vec<&dyn Waitable> = taps.iter().map(|t| t.waitable()).collect();
     let _attached = pace.attach(&waiter, &waitables)?;
     let flush_every = Duration::from_millis(args.flush_ms.max(1));
+    let half_flush_ns = args.flush_ms.max(1) * 500_000;
     let writer = Writer::start(Files { mcap: rec, rrd }, flush_every)?;
     harvey_runtime::notify_ready()?;
     tracing::info!(output = %args.output.display(), topics = taps.len(), lockstep, "recording");
 
     let mut intake = Intake { batch: Batch::default(), spare: Vec::new(), until_ns: u64::MAX, left_out: 0 };
     let mut last_turn: Option<Instant> = None;
-    let (mut turns_held, mut last_send) = (0usize, Instant::now());
+    let (mut turns_held, mut last_send, mut sent_ns) = (0usize, Instant::now(), 0u64);
     loop {
         let step = pace.next(&waiter, Some(flush_every))?;
         if let Step::Go(Some(tick)) = step {
@@ -174,10 +199,14 @@ fn main() -> anyhow::Result<()> {
         let due = step == Step::Stop
             || turns_held >= TICKS_PER_BATCH
             || intake.batch.bytes >= BATCH_BYTES
-            || last_send.elapsed() >= flush_every / 2;
+            || last_send.elapsed() >= flush_every / 2
+            || intake.until_ns != u64::MAX && intake.until_ns >= sent_ns.saturating_add(half_flush_ns);
         if due && (!intake.batch.items.is_empty() || !intake.batch.loop_latency.is_empty()) {
             writer.send(std::mem::take(&mut intake.batch))?;
             (turns_held, last_send) = (0, Instant::now());
+            if intake.until_ns != u64::MAX {
+                sent_ns = intake.until_ns;
+            }
         }
         if step == Step::Stop {
             break;

@@ -30,7 +30,9 @@ pub struct Writer {
 }
 
 impl Writer {
-    /// Starts the thread; it flushes both files at least every `flush_every`.
+    /// Starts the thread; it flushes both files at least every `flush_every` of wall time, and
+    /// of the messages' own time (a deterministic run goes many times faster than real time:
+    /// what a SIGKILL loses stays within the interval in both).
     pub fn start(files: Files, flush_every: Duration) -> anyhow::Result<Self> {
         let (to_writer, batches) = sync_channel(QUEUE);
         let (give_back, returned) = std::sync::mpsc::channel();
@@ -67,9 +69,12 @@ fn write_loop(
     flush_every: Duration,
 ) -> anyhow::Result<Vec<ChannelStats>> {
     let mut last_flush = Instant::now();
+    let flush_ns = u64::try_from(flush_every.as_nanos()).unwrap_or(u64::MAX);
+    let (mut flushed_ns, mut newest_ns) = (0u64, 0u64);
     loop {
         match batches.recv_timeout(flush_every) {
             Ok(batch) => {
+                newest_ns = batch.items.iter().map(|i| i.stamp_ns).fold(newest_ns, u64::max);
                 for i in &batch.items {
                     files.mcap.record_encoded(i.channel, i.seq, i.stamp_ns, &i.data)?;
                     if let Some(rrd) = files.rrd.as_mut() {
@@ -87,7 +92,8 @@ fn write_loop(
             Err(RecvTimeoutError::Timeout) => {}
             Err(RecvTimeoutError::Disconnected) => break,
         }
-        if last_flush.elapsed() >= flush_every {
+        if last_flush.elapsed() >= flush_every || newest_ns >= flushed_ns.saturating_add(flush_ns) {
+            flushed_ns = newest_ns;
             files.mcap.flush()?;
             if let Some(rrd) = &files.rrd {
                 rrd.flush()?;

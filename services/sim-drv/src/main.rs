@@ -8,11 +8,15 @@ use std::time::{Duration, Instant};
 use anyhow::Context;
 use clap::Parser;
 use harvey_bus::{Bus, FdSource, Waiter, Wake};
-use harvey_drv_protocol::serial::{make_raw, read_available, set_nonblocking, write_frame};
-use harvey_drv_protocol::{Decoder, Line, encode};
-use harvey_msgs::{Header, TruePose, topics};
+use harvey_drv_protocol::Decoder;
+use harvey_drv_protocol::serial::{make_raw, read_available, set_nonblocking};
+use harvey_msgs::topics;
 use harvey_sim_drv::SimDrv;
 use harvey_sim_drv::watchdog::HostWatchdog;
+
+mod drive;
+
+use drive::Drive;
 
 #[derive(Parser)]
 #[command(about = "Simulated Denning DRV speaking the DRV protocol on a pseudo-terminal")]
@@ -60,7 +64,7 @@ fn main() -> anyhow::Result<()> {
     if let Some(file) = &args.movers {
         world.add_movers(harvey_world::load_movers(file)?);
     }
-    let mut sim = SimDrv::new(world, args.tick_ms, args.seed);
+    let sim = SimDrv::new(world, args.tick_ms, args.seed);
 
     let bus = Bus::join("sim-drv")?;
     let truth_pub = bus.publisher(topics::SIM_TRUTH)?;
@@ -85,16 +89,13 @@ fn main() -> anyhow::Result<()> {
     // Deterministic mode: no timer; each `SY` from the bridge (after the tick's commands)
     // releases the next tick. Real time: a tick every `tick_ms / speedup` of wall time.
     let lockstep = harvey_bus::lockstep_from_env();
+    let checkpoint = harvey_runtime::Checkpoint::from_env("sim-drv", drive::SLOT_BYTES)?;
+    let mut drive =
+        Drive::new(sim, HostWatchdog::new(args.watchdog_ms), truth_pub, args.tick_ms, checkpoint)?;
     let period = Duration::from_secs_f64(args.tick_ms as f64 / 1000.0 / args.speedup);
     let mut next_tick = Instant::now() + period;
     let mut decoder = Decoder::new();
     let (mut buf, mut lines) = (Vec::new(), Vec::new());
-    let mut dropped_frames = 0u64;
-    let mut watchdog = HostWatchdog::new(args.watchdog_ms);
-    let mut send = |line: &mut File, l: &Line| -> anyhow::Result<()> {
-        dropped_frames += u64::from(!write_frame(line, encode(l).as_bytes())?);
-        Ok(())
-    };
     loop {
         let now = Instant::now();
         let timeout = (!lockstep).then(|| next_tick.saturating_duration_since(now));
@@ -107,59 +108,15 @@ fn main() -> anyhow::Result<()> {
             Ok(l) => lines.push(l),
             Err(e) => tracing::warn!("bad frame from the host: {e}"),
         });
-        let mut due = !lockstep && Instant::now() >= next_tick;
-        for l in &lines {
-            watchdog.feed(sim.time_ms());
-            match *l {
-                Line::Command(cmd) => send(&mut line, &Line::Report(sim.handle(cmd)))?,
-                Line::Sync { time_ms } if lockstep => {
-                    if time_ms != sim.time_ms() {
-                        tracing::warn!(time_ms, sim_ms = sim.time_ms(), "SY for another tick");
-                    }
-                    due = true;
-                }
-                Line::Heartbeat { .. } => {}
-                other => tracing::warn!(?other, "ignoring a frame the DRV does not take here"),
-            }
-            if due && lockstep {
-                guard(&mut sim, &watchdog);
-                tick(&mut sim, &truth_pub, args.tick_ms, |l| send(&mut line, l))?;
-                send(&mut line, &Line::Tick { time_ms: sim.time_ms() })?;
-                due = false;
-            }
+        for l in lines.drain(..) {
+            drive.on_line(&mut line, l, lockstep)?;
         }
-        if due {
+        if !lockstep && Instant::now() >= next_tick {
             next_tick += period;
-            guard(&mut sim, &watchdog);
-            tick(&mut sim, &truth_pub, args.tick_ms, |l| send(&mut line, l))?;
+            drive.tick_now(&mut line)?;
         }
     }
     let _ = std::fs::remove_file(&args.pty);
-    tracing::info!(time_ms = sim.time_ms(), dropped_frames, stats = ?decoder.stats(), "simulated DRV stopped");
+    tracing::info!(time_ms = drive.sim.time_ms(), dropped_frames = drive.dropped_frames, stats = ?decoder.stats(), "simulated DRV stopped");
     Ok(())
-}
-
-/// The DRV's watchdog: a vehicle whose host has fallen silent stops before the next tick.
-fn guard(sim: &mut SimDrv, watchdog: &HostWatchdog) {
-    if sim.is_moving() && watchdog.lapsed(sim.time_ms()) {
-        tracing::error!(time_ms = sim.time_ms(), "no frame from the host within the deadline: stopping");
-        sim.halt();
-    }
-}
-
-/// Simulates one tick: the truth goes to the bus, the reports down the line.
-fn tick(
-    sim: &mut SimDrv,
-    truth_pub: &harvey_bus::Publisher<TruePose>,
-    tick_ms: u64,
-    mut send: impl FnMut(&Line) -> anyhow::Result<()>,
-) -> anyhow::Result<()> {
-    let out = sim.tick();
-    let stamp_ns = out.time_ms * 1_000_000;
-    let pose = out.truth;
-    truth_pub.send(&TruePose {
-        header: Header::new(stamp_ns / (tick_ms * 1_000_000), stamp_ns),
-        world_from_robot: pose,
-    })?;
-    out.reports.iter().try_for_each(|r| send(&Line::Report(*r)))
 }

@@ -9,7 +9,7 @@ use harvey_geometry::Rng;
 pub use harvey_geometry::{FT, Pose2};
 
 /// A motion under way: where it started, where it will end (true and encoder), how far along.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum Motion {
     Move {
         truth0: Pose2,
