@@ -68,6 +68,10 @@ enum Cmd {
     /// Run a mission over seeds x sensor conditions in parallel and tabulate its figure
     /// (DIR/sweep.csv, sweep.md, sweep.png); exit 1 if a run failed, 130 if interrupted.
     Sweep(cmd::sweep::SweepArgs),
+    /// Run a mission while seeded random SIGKILLs hit its services; report whether it reached
+    /// its goal, how long each service was gone and whether the recording stayed identical
+    /// (DIR/chaos.md, chaos.csv); exit 1 if a mission failed.
+    Chaos(cmd::chaos::ChaosArgs),
 }
 
 fn main() {
@@ -113,5 +117,6 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
         Cmd::Recover { recording, output } => cmd::recover::run(&recording, &output),
         Cmd::Export { recording, output } => cmd::export::run(&recording, &output),
         Cmd::Sweep(args) => cmd::sweep::run(&args),
+        Cmd::Chaos(args) => cmd::chaos::run(&args),
     }
 }

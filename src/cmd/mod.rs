@@ -1,6 +1,7 @@
 //! The CLI's commands, one file each, and what several of them share: launching a launch file
 //! under the supervisor and reporting a comparison of two recordings.
 
+pub mod chaos;
 pub mod diff;
 pub mod export;
 pub mod info;
