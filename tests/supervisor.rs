@@ -210,6 +210,21 @@ fn a_service_that_dies_at_start_up_stops_the_launch_cleanly() {
 }
 
 #[test]
+fn a_launch_past_its_wall_clock_limit_is_stopped() {
+    let prefix = common::unique_prefix("wall");
+    let dir = common::scratch("wall");
+    // The encoders never exit on their own: without the limit this launch runs for ever.
+    let text = PIPELINE.replace("grace_period_ms = 2000", "grace_period_ms = 2000\nwall_limit_s = 2");
+    let started = Instant::now();
+    let (status, out) = output(launch(&write_launch(&dir, &text), &prefix, &dir), Duration::from_secs(60));
+    assert_eq!(status.code(), Some(124), "{out}");
+    assert!(out.contains("the launch ran past its wall-clock limit"), "{out}");
+    assert!(started.elapsed() >= Duration::from_secs(2), "not before the limit");
+    assert_eq!(common::processes_with_prefix(&prefix), Vec::<u32>::new(), "orphans");
+    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new(), "stale shared memory");
+}
+
+#[test]
 fn a_crash_looping_service_exhausts_its_restarts_and_ends_the_launch() {
     let prefix = common::unique_prefix("loop");
     let dir = common::scratch("loop");

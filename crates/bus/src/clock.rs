@@ -100,6 +100,8 @@ pub enum Step {
 /// How a service paces its loop.
 pub struct Pace {
     lockstep: Option<Lockstep>,
+    /// Deterministic mode: the supervisor's requests to re-offer to a restarted party.
+    reoffers: Option<std::rc::Rc<crate::Reoffers>>,
     pending: RefCell<VecDeque<u64>>,
     current: Cell<Option<u64>>,
     stopping: Cell<bool>,
@@ -108,12 +110,17 @@ pub struct Pace {
 impl Pace {
     /// Deterministic if the environment makes this service a clock party, else real time.
     pub fn from_env(bus: &Bus) -> Result<Self> {
-        Ok(Self::with(Lockstep::from_env(bus)?))
+        let mut pace = Self::with(Lockstep::from_env(bus)?);
+        if pace.lockstep.is_some() {
+            pace.reoffers = Some(bus.reoffers());
+        }
+        Ok(pace)
     }
 
     pub fn with(lockstep: Option<Lockstep>) -> Self {
         Self {
             lockstep,
+            reoffers: None,
             pending: RefCell::new(VecDeque::new()),
             current: Cell::new(None),
             stopping: Cell::new(false),
@@ -132,7 +139,13 @@ impl Pace {
         inputs: &[&'a dyn Waitable],
     ) -> Result<Vec<Attachment<'w, 'a>>> {
         match &self.lockstep {
-            Some(l) => Ok(vec![waiter.attach(l.predecessor())?]),
+            Some(l) => {
+                let mut a = vec![waiter.attach(l.predecessor())?];
+                if let Some(r) = &self.reoffers {
+                    a.push(waiter.attach(r.as_ref())?);
+                }
+                Ok(a)
+            }
             None => inputs.iter().map(|i| waiter.attach(*i)).collect(),
         }
     }
@@ -156,6 +169,9 @@ impl Pace {
                 return Ok(Step::Stop);
             }
             let wake = waiter.wait(timeout)?;
+            if let Some(r) = &self.reoffers {
+                r.serve()?;
+            }
             l.finished(|t| self.pending.borrow_mut().push_back(t))?;
             match wake {
                 Wake::Shutdown => self.stopping.set(true),

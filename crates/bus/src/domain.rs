@@ -39,6 +39,8 @@ pub(crate) fn domain_config(prefix: &str) -> Result<Config> {
 pub struct Bus {
     pub(crate) node: Node<ipc::Service>,
     pub(crate) prefix: String,
+    /// This process's publishers, re-offered when the supervisor asks (`reoffer.rs`).
+    pub(crate) reoffers: std::rc::Rc<crate::reoffer::Reoffers>,
 }
 
 impl Bus {
@@ -62,7 +64,20 @@ impl Bus {
             .map_err(|e| fail(format!("{e:?}")))?;
         // The node has opened or created the domain's management segment: keep it private.
         crate::shm::make_private(prefix);
-        Ok(Self { node, prefix: prefix.to_owned() })
+        let reoffers = std::rc::Rc::new(crate::reoffer::Reoffers::new(&node)?);
+        Ok(Self { node, prefix: prefix.to_owned(), reoffers })
+    }
+
+    /// What wakes this process when the supervisor asks it to re-offer its publishers' history
+    /// to a restarted subscriber; attach it to the loop's waiter and call [`Bus::serve_reoffers`]
+    /// on each wake-up ([`crate::Pace`] does both).
+    pub fn reoffers(&self) -> std::rc::Rc<crate::reoffer::Reoffers> {
+        self.reoffers.clone()
+    }
+
+    /// Answers the supervisor's pending re-offer requests; returns how many.
+    pub fn serve_reoffers(&self) -> Result<usize> {
+        self.reoffers.serve()
     }
 
     pub fn prefix(&self) -> &str {

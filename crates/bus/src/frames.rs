@@ -32,7 +32,7 @@ fn open_frame_service(
 pub struct FramePublisher {
     topic: &'static str,
     max_frame_bytes: usize,
-    port: IoxPublisher<ipc::Service, [u8], FrameHeader>,
+    port: std::rc::Rc<IoxPublisher<ipc::Service, [u8], FrameHeader>>,
     notifier: Notifier<ipc::Service>,
 }
 
@@ -168,7 +168,12 @@ impl Bus {
             .notifier_builder()
             .create()
             .map_err(|e| BusError::topic(topic.name, "cannot create a notifier", e))?;
-        Ok(FramePublisher { topic: topic.name, max_frame_bytes, port, notifier })
+        Ok(FramePublisher {
+            topic: topic.name,
+            max_frame_bytes,
+            port: crate::reoffer::registered(self, port),
+            notifier,
+        })
     }
 
     pub fn frame_subscriber(&self, topic: FrameTopic) -> Result<FrameSubscriber> {

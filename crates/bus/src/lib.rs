@@ -16,6 +16,7 @@ mod domain;
 mod error;
 mod frames;
 mod pubsub;
+mod reoffer;
 mod shm;
 mod waiter;
 
@@ -26,6 +27,7 @@ pub use domain::{
 pub use error::BusError;
 pub use frames::{Frame, FrameLoan, FramePublisher, FrameSubscriber};
 pub use pubsub::{Publisher, Subscriber};
+pub use reoffer::{REOFFERED, ReofferRequests, Reoffers};
 pub use shm::domain_files;
 pub use waiter::{Attachment, FdSource, Waitable, Waiter, Wake};
 

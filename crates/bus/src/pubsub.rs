@@ -68,7 +68,7 @@ fn open_service<T: Message>(
 /// Publishes messages of type `T` on one topic.
 pub struct Publisher<T: Message> {
     topic: &'static str,
-    port: IoxPublisher<ipc::Service, T, ()>,
+    port: std::rc::Rc<IoxPublisher<ipc::Service, T, ()>>,
     notifier: Notifier<ipc::Service>,
 }
 
@@ -84,7 +84,7 @@ impl<T: Message> Publisher<T> {
             .notifier_builder()
             .create()
             .map_err(|e| BusError::topic(topic.name, "cannot create a notifier", e))?;
-        Ok(Self { topic: topic.name, port, notifier })
+        Ok(Self { topic: topic.name, port: crate::reoffer::registered(bus, port), notifier })
     }
 
     pub fn topic(&self) -> &'static str {

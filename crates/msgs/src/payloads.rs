@@ -60,7 +60,7 @@ pub struct SonarRaw {
 message!(SonarRaw);
 
 /// The whole ring, latest reading of each sensor with its geometry in the robot frame.
-#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 #[type_name("harvey_msgs/SonarRing")]
 pub struct SonarRing {

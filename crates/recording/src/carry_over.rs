@@ -19,6 +19,9 @@ pub struct CarriedOver {
     pub skipped: u64,
     /// File offsets of chunks whose CRC did not check (the killed writer's last, cut short).
     pub damaged_chunks: Vec<u64>,
+    /// Per topic, the newest (log time, sequence) carried over: a restarted subscriber is
+    /// handed a topic's newest message again, which may be one of these.
+    pub newest: std::collections::BTreeMap<String, (u64, u32)>,
 }
 
 /// Where the predecessor's file waits while it is copied.
@@ -68,6 +71,8 @@ pub fn carry_over<E: From<RecordingError>>(
             rec.record_encoded(ch, u64::from(m.sequence), m.log_time, &m.data)?;
             each(topic, &m.data)?;
             out.messages += 1;
+            let newest = out.newest.entry(topic.to_owned()).or_insert((m.log_time, m.sequence));
+            *newest = (*newest).max((m.log_time, m.sequence));
         }
     }
     out.damaged_chunks = messages.damaged_chunks;

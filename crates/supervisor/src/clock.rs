@@ -3,12 +3,14 @@
 
 use std::time::{Duration, Instant};
 
-use harvey_bus::{Bus, BusError, Publisher, Subscriber};
+use harvey_bus::{Bus, BusError, Publisher, ReofferRequests, Subscriber};
 use harvey_msgs::{Header, Progress, topics};
 
 /// How long the chain may stand still before the supervisor names the party it waits for, and
 /// how often it says so again while the stall lasts.
 const STALL_WARNING: Duration = Duration::from_secs(5);
+/// How long the supervisor waits for every process to re-offer to a restarted party.
+const REOFFER_TIMEOUT: Duration = Duration::from_secs(2);
 
 struct Party {
     name: String,
@@ -24,6 +26,7 @@ pub struct ClockWatch {
     moved_at: Instant,
     /// When the stall was last reported.
     warned_at: Option<Instant>,
+    reoffers: ReofferRequests,
     _bus: Bus,
 }
 
@@ -43,7 +46,8 @@ impl ClockWatch {
                 })
             })
             .collect::<Result<Vec<_>, BusError>>()?;
-        Ok(Self { parties, moved_at: Instant::now(), warned_at: None, _bus: bus })
+        let reoffers = ReofferRequests::new(&bus)?;
+        Ok(Self { parties, moved_at: Instant::now(), warned_at: None, reoffers, _bus: bus })
     }
 
     /// Starts the chain: the tail "has finished" tick 0, so the master begins tick 1.
@@ -98,7 +102,26 @@ impl ClockWatch {
     /// is the tick the tail finished, which is the master's own last one: it gets that tick
     /// again whenever the tail has caught up with it (the master, the bridge, tells a repeat
     /// from news).
-    pub fn resume(&mut self, party: &str) -> Result<(), BusError> {
+    ///
+    /// First every other process (`others`, by pid) re-offers its publishers' newest messages,
+    /// so that the restarted party finds the inputs of the tick it missed (`harvey_bus`'s
+    /// `reoffer.rs`).
+    pub fn resume(&mut self, party: &str, others: &[u32]) -> Result<(), BusError> {
+        let n = self.reoffers.request()?;
+        let (mut answered, since) = (Vec::new(), Instant::now());
+        while others.iter().any(|p| !answered.contains(p)) && since.elapsed() < REOFFER_TIMEOUT {
+            std::thread::sleep(Duration::from_millis(1));
+            self.reoffers.answered(n, &mut answered)?;
+        }
+        let silent: Vec<&u32> = others.iter().filter(|p| !answered.contains(p)).collect();
+        if !silent.is_empty() {
+            tracing::warn!(
+                party,
+                ?silent,
+                "processes did not re-offer to the restarted party within {} s",
+                REOFFER_TIMEOUT.as_secs()
+            );
+        }
         self.poll()?;
         let n = self.parties.len();
         let Some(i) = self.parties.iter().position(|p| p.name == party) else { return Ok(()) };

@@ -57,9 +57,9 @@ pub fn supervise(
                 return Ok(outcome);
             }
         }
-        for slot in slots.iter_mut() {
-            if slot.policy.take_due(now)
-                && let Some(outcome) = restart(slot, prefix, clock.as_deref_mut(), ready)?
+        for i in 0..slots.len() {
+            if slots[i].policy.take_due(now)
+                && let Some(outcome) = restart(slots, i, prefix, clock.as_deref_mut(), ready)?
             {
                 return Ok(outcome);
             }
@@ -96,18 +96,27 @@ fn exited(slot: &mut Slot, status: ExitStatus, now: Instant, end_with: Option<&s
 /// Starts a service again after cleaning the bus of dead nodes; a failed start counts as a
 /// failure and may end the launch.
 fn restart(
-    slot: &mut Slot,
+    slots: &mut [Slot],
+    i: usize,
     prefix: &str,
     clock: Option<&mut ClockWatch>,
     ready: Duration,
 ) -> Result<Option<Outcome>, SupervisorError> {
     let cleaned = harvey_bus::cleanup_dead_nodes(prefix)?;
+    let slot = &mut slots[i];
     match slot.spawn(ready) {
         Ok(r) => {
             tracing::info!(service = %r.name, pid = r.child.id(), cleaned, "restarted");
             slot.running = Some(r);
             if let Some(c) = clock {
-                c.resume(slot.name())?;
+                let name = slots[i].name().to_owned();
+                let others: Vec<u32> = slots
+                    .iter()
+                    .enumerate()
+                    .filter(|(j, _)| *j != i)
+                    .filter_map(|(_, s)| s.running.as_ref().map(|r| r.child.id()))
+                    .collect();
+                c.resume(&name, &others)?;
             }
             Ok(None)
         }

@@ -163,14 +163,21 @@ fn main() -> anyhow::Result<()> {
     let truth = bus.subscriber(topics::SIM_TRUTH)?;
     let pace = Pace::from_env(&bus)?;
     let _a = pace.attach(&waiter, &[&truth])?;
+    // The frame count is the camera's only state (the effects are drawn from seed, frame and
+    // stamp): checkpointed, a restarted camera numbers on and draws the same noise.
+    let mut resume = harvey_runtime::Resume::from_env("camera", 4 << 10, || 0u64)?;
+    cam.seq = *resume.state();
     harvey_runtime::notify_ready()?;
     let every = args.every.max(1);
     let mut poses = Vec::new();
     while pace.next(&waiter, None)? != Step::Stop {
         truth.drain_into(&mut poses)?;
+        poses.retain(|t| resume.fresh(truth.topic(), t.header.stamp_ns, t.header.seq));
         for t in poses.iter().filter(|t| t.header.seq % every == 0) {
             cam.shoot(t.world_from_robot, t.header.stamp_ns)?;
         }
+        *resume.state() = cam.seq;
+        resume.tick_done()?;
         pace.done()?;
     }
     tracing::info!(frames = cam.seq, "camera stopped");

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, FdSource, Lockstep, Publisher, Subscriber, Waiter, Wake};
+use harvey_bus::{Bus, FdSource, Lockstep, Publisher, Reoffers, Subscriber, Waiter, Wake};
 use harvey_denning_bridge::{
     BridgeState, Outgoing, SHUTDOWN_STOP_ID, Source, WATCHDOG_STOP_ID, prioritise, to_drv,
 };
@@ -44,7 +44,12 @@ fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
     let reopen_for = Duration::from_secs_f64(args.reopen_s.max(0.0));
-    let port = open_line(&args.device, reopen_for)?;
+    let mut checkpoint = Checkpoint::from_env("denning-bridge", SLOT_BYTES)?;
+    let restored = checkpoint.as_mut().map(|c| c.load::<BridgeState>()).transpose()?.flatten();
+    // A fresh start with no line is a mistake in the launch: say so at once. A restart may
+    // race the simulated DRV's own: wait for its line.
+    let first_wait = if restored.is_some() { reopen_for } else { Duration::ZERO };
+    let port = open_line(&args.device, first_wait)?;
 
     let bus = Bus::join("denning-bridge")?;
     let ports = Ports {
@@ -59,15 +64,19 @@ fn main() -> anyhow::Result<()> {
     // the DRV's `TK` closes its reports; when the chain's tail has finished the tick, the
     // tick's commands go out, closed by `SY`.
     let lockstep = Lockstep::from_env(&bus)?;
-    let mut checkpoint = Checkpoint::from_env("denning-bridge", SLOT_BYTES)?;
-    let restored = checkpoint.as_mut().map(|c| c.load::<BridgeState>()).transpose()?.flatten();
     let mut resumed = restored.is_some();
     let mut state = restored
         .unwrap_or_else(|| BridgeState::new(args.panic_hold_ms * 1_000_000, args.watchdog_ms * 1_000_000));
     if resumed {
         tracing::warn!(synced_ms = ?state.synced, "resumed from the checkpoint");
+        // What the predecessor left half read on the line goes: the DRV sends the whole tick
+        // again when the last round comes again.
+        state.forget_unfinished_tick();
+        nix::sys::termios::tcflush(&port, nix::sys::termios::FlushArg::TCIFLUSH)
+            .with_context(|| format!("flushing {}", args.device.display()))?;
     }
     let waiter = Waiter::new()?;
+    let reoffers = bus.reoffers();
     harvey_runtime::notify_ready()?;
     tracing::info!(device = %args.device.display(), lockstep = lockstep.is_some(), "bridge up");
 
@@ -81,7 +90,7 @@ fn main() -> anyhow::Result<()> {
                 link.send_raw(&frame)?;
             }
         }
-        match run(&args, &mut link, &lockstep, &waiter, &ports) {
+        match run(&args, &mut link, &lockstep, &waiter, &ports, &reoffers) {
             Ok(Ended::Shutdown) => break Ok(()),
             Ok(Ended::HungUp) => {
                 tracing::warn!(device = %args.device.display(), "the DRV line hung up: reopening");
@@ -204,6 +213,7 @@ fn run(
     lockstep: &Option<Lockstep>,
     waiter: &Waiter,
     ports: &Ports,
+    reoffers: &Reoffers,
 ) -> anyhow::Result<Ended> {
     let line_source = FdSource::new(&link.port)?;
     let _a = match lockstep {
@@ -216,6 +226,11 @@ fn run(
         Some(_) => None,
         None => Some((waiter.attach(&ports.reflexes)?, waiter.attach(&ports.heartbeat)?)),
     };
+    // Lockstep: the supervisor asks for re-offers when a party restarts.
+    let _d = match lockstep {
+        Some(_) => Some(waiter.attach(reoffers)?),
+        None => None,
+    };
     let mut decoder = Decoder::new();
     let (mut buf, mut batch, mut ticks, mut round) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     loop {
@@ -223,6 +238,7 @@ fn run(
             tracing::info!(stats = ?decoder.stats(), "bridge stopped");
             return Ok(Ended::Shutdown);
         }
+        reoffers.serve()?;
         let beats = ports.heartbeat.drain(|_| {})?;
         let mut commanded = false;
         match lockstep {

@@ -1,13 +1,13 @@
 //! harvey-encoders: DRV shaft-encoder reports and motion commands in, odometry out. Its state
 //! (the command under way and where it started) is checkpointed at every tick, so a restarted
-//! encoders service goes on with the same command and neither loses nor repeats a message.
+//! encoders service goes on with the same command (`harvey_runtime::Resume`).
 
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_encoders::OdometryBuilder;
 use harvey_msgs::{Message, topics};
 use harvey_runtime::Resume;
 
-/// Room for the builder and the marks of three inputs and one output.
+/// Room for the builder and the marks of its three inputs.
 const SLOT_BYTES: usize = 4 << 10;
 
 fn main() -> anyhow::Result<()> {
@@ -44,9 +44,7 @@ fn main() -> anyhow::Result<()> {
         for r in &reports {
             match resume.state().on_encoders(r) {
                 Ok(odo) => {
-                    if resume.send_due(odometry.topic(), odo.header.stamp_ns, odo.header.seq)? {
-                        odometry.send(&odo)?;
-                    }
+                    odometry.send(&odo)?;
                 }
                 Err(e) => tracing::warn!("dropping an encoder report: {e}"),
             }

@@ -144,6 +144,7 @@ fn main() -> anyhow::Result<()> {
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();
     let missing: Vec<&&str> = topics::ALL.iter().filter(|t| !recorded.contains(t)).collect();
     anyhow::ensure!(missing.is_empty(), "the recorder has no tap for {missing:?}");
+    let mut recorded = std::collections::BTreeMap::new();
     if let Some(old) = &interrupted {
         let carried = carry_over::carry_over(old, &mut rec, |topic, data| -> anyhow::Result<()> {
             if let Some(rrd) = rrd.as_mut() {
@@ -152,6 +153,7 @@ fn main() -> anyhow::Result<()> {
             Ok(())
         })?;
         tracing::warn!(messages = carried.messages, damaged_chunks = ?carried.damaged_chunks, from = %old.display(), "continuing the recording a killed recorder left");
+        recorded = carried.newest;
     }
     if let Some(c) = checkpoint.as_mut() {
         c.save(&Started { recording: true })?;
@@ -162,12 +164,13 @@ fn main() -> anyhow::Result<()> {
     let waitables: Vec<&dyn Waitable> = taps.iter().map(|t| t.waitable()).collect();
     let _attached = pace.attach(&waiter, &waitables)?;
     let flush_every = Duration::from_millis(args.flush_ms.max(1));
-    let half_flush_ns = args.flush_ms.max(1) * 500_000;
+    let quarter_flush_ns = args.flush_ms.max(1) * 250_000;
     let writer = Writer::start(Files { mcap: rec, rrd }, flush_every)?;
     harvey_runtime::notify_ready()?;
     tracing::info!(output = %args.output.display(), topics = taps.len(), lockstep, "recording");
 
-    let mut intake = Intake { batch: Batch::default(), spare: Vec::new(), until_ns: u64::MAX, left_out: 0 };
+    let mut intake =
+        Intake { batch: Batch::default(), spare: Vec::new(), until_ns: u64::MAX, left_out: 0, recorded };
     let mut last_turn: Option<Instant> = None;
     let (mut turns_held, mut last_send, mut sent_ns) = (0usize, Instant::now(), 0u64);
     loop {
@@ -200,7 +203,7 @@ fn main() -> anyhow::Result<()> {
             || turns_held >= TICKS_PER_BATCH
             || intake.batch.bytes >= BATCH_BYTES
             || last_send.elapsed() >= flush_every / 2
-            || intake.until_ns != u64::MAX && intake.until_ns >= sent_ns.saturating_add(half_flush_ns);
+            || intake.until_ns != u64::MAX && intake.until_ns >= sent_ns.saturating_add(quarter_flush_ns);
         if due && (!intake.batch.items.is_empty() || !intake.batch.loop_latency.is_empty()) {
             writer.send(std::mem::take(&mut intake.batch))?;
             (turns_held, last_send) = (0, Instant::now());

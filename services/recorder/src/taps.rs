@@ -1,6 +1,8 @@
 //! The recorder's taps: one subscription per topic, taking its queued messages out of shared
 //! memory as CDR into a [`Batch`] for the writer thread.
 
+use std::collections::BTreeMap;
+
 use harvey_bus::{FrameSubscriber, Subscriber, Waitable};
 use harvey_cdr::{Ros2Msg, encode, encode_image};
 use harvey_msgs::Message;
@@ -35,13 +37,17 @@ pub struct Intake {
     /// stopped inside it) and are left out.
     pub until_ns: u64,
     pub left_out: u64,
+    /// A continued recording: per topic, the newest (stamp, sequence) already in it.
+    pub recorded: BTreeMap<String, (u64, u32)>,
 }
 
 impl Intake {
-    fn admits(&mut self, stamp_ns: u64) -> bool {
+    fn admits(&mut self, topic: &str, stamp_ns: u64, seq: u64) -> bool {
         let keep = stamp_ns <= self.until_ns;
         self.left_out += u64::from(!keep);
-        keep
+        // The MCAP sequence is the message's number modulo 2^32, as the writer keeps it.
+        let seen = self.recorded.get(topic).is_some_and(|&m| (stamp_ns, seq as u32) <= m);
+        keep && !seen
     }
 
     /// A spare buffer that holds `bytes` without growing (a fresh frame-sized buffer would cost
@@ -93,7 +99,7 @@ impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
     fn take(&self, into: &mut Intake) -> anyhow::Result<usize> {
         Ok(self.sub.drain(|m| {
             let h = *m.header();
-            if into.admits(h.stamp_ns) {
+            if into.admits(self.sub.topic(), h.stamp_ns, h.seq) {
                 let bytes = 64 + core::mem::size_of::<T>();
                 into.push(self.channel, self.sub.topic(), (h.seq, h.stamp_ns, bytes), |buf| encode(m, buf));
             }
@@ -118,7 +124,7 @@ impl Tap for FrameTap {
             && let Some(frame) = self.sub.take()?
         {
             let h = *frame.header();
-            if into.admits(h.stamp_ns) {
+            if into.admits(self.sub.topic(), h.stamp_ns, h.seq) {
                 let bytes = 128 + frame.pixels().len();
                 into.push(self.channel, self.sub.topic(), (h.seq, h.stamp_ns, bytes), |buf| {
                     encode_image(&h, frame.pixels(), buf)

@@ -83,6 +83,10 @@ fn main() -> anyhow::Result<()> {
     let waiter = Waiter::new()?;
     let line_source = FdSource::new(&line)?;
     let _line_attached = waiter.attach(&line_source)?;
+    // Lockstep: the supervisor asks for re-offers (of `sim/truth`) when a party restarts.
+    let reoffers = bus.reoffers();
+    let _reoffers_attached =
+        if harvey_bus::lockstep_from_env() { Some(waiter.attach(reoffers.as_ref())?) } else { None };
     harvey_runtime::notify_ready()?;
     tracing::info!(pty = %args.pty.display(), tty = %slave_path.display(), seed = args.seed, "simulated DRV up");
 
@@ -102,6 +106,7 @@ fn main() -> anyhow::Result<()> {
         if (lockstep || now < next_tick) && waiter.wait(timeout)? == Wake::Shutdown {
             break;
         }
+        reoffers.serve()?;
         read_available(&mut line, &mut buf).context("reading the pseudo-terminal")?;
         lines.clear();
         decoder.push(&buf, |frame| match frame {

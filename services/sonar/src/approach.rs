@@ -26,7 +26,7 @@ const POSES: usize = 16;
 const MAX_STEP_M: f64 = 0.3;
 
 /// Settings.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ApproachParams {
     /// Least speed (m/s) of the object itself towards the robot.
     pub min_approach_mps: f64,
@@ -37,7 +37,7 @@ pub struct ApproachParams {
 }
 
 /// One reading: its time (s), range (m), the robot's position (m) and the sensor's axis.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 struct Reading {
     t: f64,
     r: f64,
@@ -53,7 +53,7 @@ impl Reading {
     }
 }
 
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy, Default, serde::Serialize, serde::Deserialize)]
 struct Window {
     n: usize,
     readings: [Reading; WINDOW],
@@ -97,7 +97,7 @@ impl Window {
 }
 
 /// The detector: odometry history and one window per sensor.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct Approach {
     p: ApproachParams,
     poses: VecDeque<(u64, Pose2)>,

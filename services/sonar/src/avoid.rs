@@ -14,7 +14,7 @@ use crate::bearing_rad;
 const ID_BASE: u32 = harvey_msgs::REFLEX_ID_BIT;
 
 /// Settings (the paper gives the right-angle turn; the rest are this system's choices).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct AvoidParams {
     /// Time to contact (s) under which an approaching object counts.
     pub ttc_s: f64,
@@ -32,7 +32,7 @@ pub struct AvoidParams {
     pub stop_m: f64,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 enum Phase {
     Watching,
     /// Stop sent; waiting for the vehicle to be still.
@@ -69,7 +69,7 @@ const MIN_DASH_M: f64 = 0.1;
 const MAX_TURN_RAD: f64 = 0.052;
 
 /// The reflex's state: the approach detector, the evasion's phase.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct PanicAvoid {
     p: AvoidParams,
     approach: Approach,

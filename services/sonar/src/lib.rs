@@ -33,7 +33,7 @@ pub struct Update {
 }
 
 /// The ring being assembled and the reflex's state.
-#[derive(Debug)]
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
 pub struct SonarRingBuilder {
     ring: SonarRing,
     panic_stop_m: f64,

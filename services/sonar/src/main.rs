@@ -1,9 +1,11 @@
 //! harvey-sonar: raw DRV sonar banks in, the 24-sensor ring out; the panic-stop and panic-avoid
-//! reflexes' commands go straight to the vehicle (001 §6.2).
+//! reflexes' commands go straight to the vehicle (001 §6.2). The ring and the reflexes' state are
+//! checkpointed every tick, so a restarted sonar service goes on where it was.
 
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
-use harvey_msgs::topics;
+use harvey_msgs::{Message, topics};
+use harvey_runtime::Resume;
 use harvey_sonar::SonarRingBuilder;
 use harvey_sonar::avoid::{AvoidParams, PanicAvoid};
 
@@ -33,6 +35,9 @@ struct Args {
     avoid_dash_ft: f64,
 }
 
+/// Room for the ring, the reflexes' state and the marks.
+const SLOT_BYTES: usize = 64 << 10;
+
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
@@ -47,8 +52,8 @@ fn main() -> anyhow::Result<()> {
     harvey_runtime::notify_ready()?;
 
     use harvey_geometry::FT;
-    let mut ring = SonarRingBuilder::new(args.panic_stop_ft * FT);
-    let mut avoid = (args.avoid_dash_ft > 0.0).then(|| {
+    let ring = SonarRingBuilder::new(args.panic_stop_ft * FT);
+    let avoid = (args.avoid_dash_ft > 0.0).then(|| {
         PanicAvoid::new(AvoidParams {
             ttc_s: args.avoid_ttc_s,
             confirm: args.avoid_confirm,
@@ -59,26 +64,32 @@ fn main() -> anyhow::Result<()> {
             stop_m: args.panic_stop_ft * FT,
         })
     });
+    let mut resume = Resume::from_env("sonar", SLOT_BYTES, || (ring, avoid))?;
+    if resume.resumed() {
+        tracing::warn!("resumed from the checkpoint");
+    }
     let (mut banks, mut poses) = (Vec::new(), Vec::new());
     let mut rings = 0u64;
     while pace.next(&waiter, None)? != Step::Stop {
         odometry.drain_into(&mut poses)?;
+        poses.retain(|m| resume.fresh(odometry.topic(), m.header().stamp_ns, m.header().seq));
         raw.drain_into(&mut banks)?;
-        if let Some(a) = avoid.as_mut() {
-            for o in &poses {
-                if let Some(c) = a.on_odometry(o) {
-                    tracing::warn!(command = c.command_id, kind = c.kind, "panic-avoid");
-                    command_pub.send(&c)?;
-                }
+        banks.retain(|m| resume.fresh(raw.topic(), m.header().stamp_ns, m.header().seq));
+        for o in &poses {
+            if let Some(c) = resume.state().1.as_mut().and_then(|a| a.on_odometry(o)) {
+                tracing::warn!(command = c.command_id, kind = c.kind, "panic-avoid");
+                command_pub.send(&c)?;
             }
         }
         for bank in &banks {
+            let (ring, avoid) = resume.state();
             match ring.on_bank(bank) {
                 Ok(update) => {
+                    let evade = avoid.as_mut().and_then(|a| a.on_ring(&update.ring));
                     if let Some(stop) = update.panic_stop {
                         command_pub.send(&stop)?;
                     }
-                    if let Some(c) = avoid.as_mut().and_then(|a| a.on_ring(&update.ring)) {
+                    if let Some(c) = evade {
                         tracing::warn!("panic-avoid: an object is bearing down; stopping to evade");
                         command_pub.send(&c)?;
                     }
@@ -88,9 +99,10 @@ fn main() -> anyhow::Result<()> {
                 Err(e) => tracing::warn!("dropping a sonar report: {e}"),
             }
         }
+        resume.tick_done()?;
         pace.done()?;
     }
-    let episodes = avoid.map_or(0, |a| a.episodes);
+    let episodes = resume.state().1.as_ref().map_or(0, |a| a.episodes);
     tracing::info!(rings, episodes, "sonar stopped");
     Ok(())
 }

@@ -27,6 +27,8 @@ pub struct Verdict {
     /// Messages of the reference the run lacks, and messages it has that the reference lacks.
     pub missing: usize,
     pub extra: usize,
+    /// Simulated seconds between the first and the last message missing.
+    pub missing_span_s: f64,
     /// Simulated time of the first message that differs.
     pub first_difference_s: Option<f64>,
     /// How far the robot's true end pose lies from the reference run's (m).
@@ -127,14 +129,17 @@ fn verdict(a: &[Record], b: &[Record]) -> Verdict {
         *counts.entry(key(r)).or_default() -= 1;
     }
     let mut v = Verdict::default();
-    for ((topic, _, _), n) in &counts {
+    let (mut first, mut last) = (u64::MAX, 0);
+    for ((topic, t, _), n) in &counts {
         if *n > 0 {
             v.missing += *n as usize;
             v.missing_topics.insert(topic.clone());
+            (first, last) = (first.min(*t), last.max(*t));
         } else if *n < 0 {
             v.extra += (-n) as usize;
         }
     }
+    v.missing_span_s = if v.missing > 0 { (last - first) as f64 / 1e9 } else { 0.0 };
     let at = a.iter().zip(b).position(|(x, y)| x != y).unwrap_or(a.len().min(b.len()));
     v.first_difference_s = a.get(at).or(b.get(at)).map(|r| r.log_time as f64 / 1e9);
     v
@@ -199,12 +204,12 @@ pub fn table(runs: &[Run], reference: &Run, cpu: &str) -> String {
 /// One line per kill, for plotting.
 pub fn csv(runs: &[Run]) -> String {
     let mut out = String::from(
-        "run,service,at_s,back_ms,exit_code,identical,missing,extra,first_difference_s,end_apart_m,shm_left\n",
+        "run,service,at_s,back_ms,exit_code,identical,missing,missing_span_s,extra,first_difference_s,end_apart_m,shm_left\n",
     );
     for r in runs {
         for k in &r.kills {
             out += &format!(
-                "{},{},{:.3},{},{},{},{},{},{},{},{}\n",
+                "{},{},{:.3},{},{},{},{},{:.3},{},{},{},{}\n",
                 r.dir.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                 k.service,
                 k.at_s,
@@ -212,6 +217,7 @@ pub fn csv(runs: &[Run]) -> String {
                 r.exit_code.map_or(String::new(), |c| c.to_string()),
                 r.verdict.identical,
                 r.verdict.missing,
+                r.verdict.missing_span_s,
                 r.verdict.extra,
                 r.verdict.first_difference_s.map_or(String::new(), |t| format!("{t:.3}")),
                 r.verdict.end_apart_m.map_or(String::new(), |m| format!("{m:.4}")),
