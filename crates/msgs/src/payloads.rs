@@ -241,7 +241,7 @@ impl SightingKind {
 }
 
 /// A landmark recognised (or not) in a frame (`vision/sightings`), in the robot frame.
-#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 #[type_name("harvey_msgs/LandmarkSighting")]
 pub struct LandmarkSighting {
@@ -259,7 +259,7 @@ pub struct LandmarkSighting {
 message!(LandmarkSighting);
 
 /// The Expecter's window for a landmark (`ums/expectations`): where to look in the next frames.
-#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 #[type_name("harvey_msgs/Expectation")]
 pub struct Expectation {

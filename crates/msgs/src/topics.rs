@@ -26,9 +26,10 @@ impl Qos {
     /// Small fixed-size messages: a few consumers plus the recorder and tools.
     pub const STATE: Qos = Qos { buffer: 16, borrowed: 2, history: 1, max_publishers: 4, max_subscribers: 8 };
     /// Camera frames: every slot costs a whole frame of shared memory, so keep them few:
-    /// 3 subscribers x (2 queued + 1 held) + 1 loaned = 10 frames (62 MB at 1080p rgb8,
-    /// 3 MB at 640x480 mono8).
-    pub const FRAMES: Qos = Qos { buffer: 2, borrowed: 1, history: 0, max_publishers: 1, max_subscribers: 3 };
+    /// 3 subscribers x (2 queued + 1 held) + 1 loaned + 1 history = 11 frames (68 MB at 1080p
+    /// rgb8, 3.4 MB at 640x480 mono8). The history frame is what a restarted consumer is
+    /// handed again (the supervisor's re-offer, `harvey_bus` `reoffer.rs`).
+    pub const FRAMES: Qos = Qos { buffer: 2, borrowed: 1, history: 1, max_publishers: 1, max_subscribers: 3 };
     /// A clock party's progress: read by its successor, the clock master and the supervisor
     /// (which also publishes, to start the chain and to resume it after a restart).
     pub const CLOCK: Qos = Qos { buffer: 8, borrowed: 1, history: 0, max_publishers: 2, max_subscribers: 4 };

@@ -99,7 +99,7 @@ impl VisionStatus {
 }
 
 /// A request to the vision workers.
-#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend)]
+#[derive(Debug, Default, Clone, Copy, PartialEq, ZeroCopySend, serde::Serialize, serde::Deserialize)]
 #[repr(C)]
 #[type_name("harvey_msgs/VisionRequest")]
 pub struct VisionRequest {

@@ -9,7 +9,7 @@
 //! integers).
 
 use std::fs::{File, OpenOptions};
-use std::os::unix::fs::FileExt;
+use std::os::unix::fs::{FileExt, OpenOptionsExt};
 use std::path::{Path, PathBuf};
 
 use serde::Serialize;
@@ -61,7 +61,8 @@ impl Checkpoint {
     pub fn open(path: &Path, slot_bytes: usize) -> Result<Self, CheckpointError> {
         let io = |source| CheckpointError::Io { path: path.to_owned(), source };
         let file =
-            OpenOptions::new().read(true).write(true).create(true).truncate(false).open(path).map_err(io)?;
+            // Owner only, as the bus's shared memory is.
+            OpenOptions::new().read(true).write(true).create(true).truncate(false).mode(0o600).open(path).map_err(io)?;
         let mut ck = Self {
             path: path.to_owned(),
             file,

@@ -12,6 +12,7 @@ mod fix;
 pub mod geometry;
 pub mod map;
 pub mod reduction;
+pub mod resume;
 
 use std::collections::VecDeque;
 
@@ -54,7 +55,7 @@ pub fn margin_px(s: Strategy) -> f64 {
 }
 
 /// One growth step taken from odometry.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 struct Step {
     turn_rad: f64,
     run_m: f64,

@@ -38,6 +38,9 @@ struct Args {
     history_ms: u64,
 }
 
+/// Room for the map, its history and the pending sightings.
+const SLOT_BYTES: usize = 1 << 20;
+
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
@@ -71,21 +74,33 @@ fn main() -> anyhow::Result<()> {
     harvey_runtime::notify_ready()?;
 
     let mut ums = Ums::new(world, config);
+    // The uncertainty as the last finished tick left it, for a restarted UMS.
+    let mut resume = harvey_runtime::Resume::from_env("ums", SLOT_BYTES, || ums.state())?;
+    if resume.resumed() {
+        ums.restore(resume.state().clone());
+        tracing::warn!(
+            area_m2 = harvey_ums::geometry::area(&ums.map().polygon),
+            "resumed from the checkpoint"
+        );
+    }
     let (mut odos, mut seen, mut fixed) = (Vec::new(), Vec::new(), Vec::new());
     while pace.next(&waiter, None)? != Step::Stop {
         sightings.drain_into(&mut seen)?;
+        seen.retain(|m| resume.fresh(sightings.topic(), m.header.stamp_ns, m.header.seq));
         for s in &seen {
             if let Err(e) = ums.on_sighting(s) {
                 tracing::warn!("rejected: {e}");
             }
         }
         fixes.drain_into(&mut fixed)?;
+        fixed.retain(|m| resume.fresh(fixes.topic(), m.header.stamp_ns, m.header.seq));
         for f in &fixed {
             if let Err(e) = ums.on_fix(f) {
                 tracing::warn!("rejected: {e}");
             }
         }
         odometry.drain_into(&mut odos)?;
+        odos.retain(|m| resume.fresh(odometry.topic(), m.header.stamp_ns, m.header.seq));
         for o in &odos {
             match ums.on_odometry(o) {
                 Ok(out) => {
@@ -100,6 +115,8 @@ fn main() -> anyhow::Result<()> {
                 Err(e) => tracing::warn!("rejected: {e}"),
             }
         }
+        *resume.state() = ums.state();
+        resume.tick_done()?;
         pace.done()?;
     }
     Ok(())

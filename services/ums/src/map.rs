@@ -13,7 +13,7 @@ use harvey_geometry::FT;
 pub const MAX_VERTICES: usize = harvey_msgs::MAX_POLYGON_VERTICES;
 
 /// Position and heading uncertainty.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Map {
     /// Convex, counter-clockwise, world frame; a single point when the pose is known exactly.
     pub polygon: Vec<Pt>,

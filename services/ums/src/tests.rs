@@ -198,3 +198,27 @@ fn expectations_are_numbered_one_by_one_across_maps() {
     assert!(seqs.len() > 20, "several windows per map: {}", seqs.len());
     assert_eq!(seqs, (1..=seqs.len() as u64).collect::<Vec<_>>());
 }
+
+#[test]
+fn a_restored_ums_goes_on_as_the_original_would() {
+    let mut a = ums();
+    for k in 1..=12 {
+        a.on_odometry(&odo(k * 50, k as f64 * 0.2)).expect("ok");
+    }
+    // A sighting waiting for its odometry travels in the state too.
+    let _ = a.on_sighting(&sighting(650, "end-wall-corner", SightingKind::Bearing, 0.01, 0.0));
+    let bytes = postcard::to_allocvec(&a.state()).expect("encodes");
+    let mut b = ums();
+    b.restore(postcard::from_bytes(&bytes).expect("decodes"));
+    assert_eq!(b.state(), a.state());
+    // A fresh UMS would not go on so: it starts from the start's point.
+    let fresh = ums().on_odometry(&odo(13 * 50, 13.0 * 0.2)).expect("ok");
+    for k in 13..=30 {
+        let (x, y) = (a.on_odometry(&odo(k * 50, k as f64 * 0.2)), b.on_odometry(&odo(k * 50, k as f64 * 0.2)));
+        let (x, y) = (x.expect("ok"), y.expect("ok"));
+        if k == 13 {
+            assert_ne!(map_of(&fresh), map_of(&y));
+        }
+        assert_eq!(x, y, "tick {k}");
+    }
+}

@@ -52,6 +52,16 @@ fn param(r: &VisionRequest, i: usize, default: f32) -> f32 {
 }
 
 impl Dispatcher {
+    /// How many messages it has numbered: kept across a restart (a checkpoint), so that a
+    /// restarted worker numbers on.
+    pub fn numbered(&self) -> u64 {
+        self.seq
+    }
+
+    pub fn number_from(&mut self, seq: u64) {
+        self.seq = seq;
+    }
+
     pub fn new(world: World) -> Self {
         Self {
             world,

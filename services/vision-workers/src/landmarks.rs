@@ -29,6 +29,16 @@ pub struct LineLandmarks {
 }
 
 impl LineLandmarks {
+    /// How many messages it has numbered: kept across a restart (a checkpoint), so that a
+    /// restarted worker numbers on.
+    pub fn numbered(&self) -> u64 {
+        self.seq
+    }
+
+    pub fn number_from(&mut self, seq: u64) {
+        self.seq = seq;
+    }
+
     pub fn new(focal_px: f64, threshold: f32) -> Self {
         Self {
             focal_px,

@@ -35,6 +35,16 @@ pub struct VerticalEdges {
 }
 
 impl VerticalEdges {
+    /// How many messages it has numbered: kept across a restart (a checkpoint), so that a
+    /// restarted worker numbers on.
+    pub fn numbered(&self) -> u64 {
+        self.seq
+    }
+
+    pub fn number_from(&mut self, seq: u64) {
+        self.seq = seq;
+    }
+
     pub fn new(band_half_rows: u32, threshold: f32) -> Self {
         Self { band_half_rows, threshold, profile: Vec::new(), found: Vec::new(), seq: 0 }
     }

@@ -8,6 +8,7 @@ use std::path::PathBuf;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::{Expectation, VisionAlgorithm, VisionRequest, topics};
+use harvey_runtime::Resume;
 use harvey_vision_workers::VerticalEdges;
 use harvey_vision_workers::dispatch::Dispatcher;
 use harvey_vision_workers::landmarks::LineLandmarks;
@@ -52,6 +53,30 @@ fn shard(text: &str) -> anyhow::Result<(u32, u32)> {
     }
 }
 
+/// Room for the requests and expectations in force.
+const SLOT_BYTES: usize = 256 << 10;
+
+/// What a worker keeps from tick to tick.
+#[derive(Default, serde::Serialize, serde::Deserialize)]
+struct Kept {
+    asked: BTreeMap<u32, VisionRequest>,
+    wanted: BTreeMap<u32, Expectation>,
+    /// The detector's, the landmark recogniser's and the dispatcher's numbering.
+    numbered: [u64; 3],
+}
+
+/// The tick is done: what is in force is saved.
+fn keep(
+    resume: &mut Resume<Kept>,
+    asked: &BTreeMap<u32, VisionRequest>,
+    wanted: &BTreeMap<u32, Expectation>,
+    numbered: [u64; 3],
+) -> anyhow::Result<()> {
+    let kept = resume.state();
+    (kept.asked, kept.wanted, kept.numbered) = (asked.clone(), wanted.clone(), numbered);
+    Ok(resume.tick_done()?)
+}
+
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
@@ -70,6 +95,10 @@ fn main() -> anyhow::Result<()> {
     let _a = pace.attach(&waiter, &[&frames, &expectations, &requests])?;
     harvey_runtime::notify_ready()?;
 
+    // What a restarted worker takes back from its checkpoint: the requests and expectations in
+    // force and its numbering. (The region tracker's and activity detector's frames are not
+    // kept: a restarted worker's begin afresh.)
+    let mut resume = Resume::from_env("vision-workers", SLOT_BYTES, Kept::default)?;
     // Requests by id (ascending, so answers come in a fixed order); one-shot ones go once answered.
     let mut asked: BTreeMap<u32, VisionRequest> = BTreeMap::new();
     if let Some(range) = &args.lines {
@@ -85,8 +114,11 @@ fn main() -> anyhow::Result<()> {
             anyhow::ensure!(win.len() == 4, "--lines-window takes U0,V0,U1,V1; got {win:?}");
             own.window_px.copy_from_slice(win);
         }
-        // Published so the recording shows what was asked; answered like any other.
-        request_pub.send(&own)?;
+        // Published so the recording shows what was asked (once: not again by a restarted
+        // worker); answered like any other.
+        if !resume.resumed() {
+            request_pub.send(&own)?;
+        }
         asked.insert(own.request_id, own);
     }
     let mut dispatcher = Dispatcher::new(world.clone());
@@ -95,19 +127,32 @@ fn main() -> anyhow::Result<()> {
     let mut lines = LineLandmarks::new(world.camera.focal_px, args.edge_threshold)
         .with_calibration_sd(world.survey.calibration_sd_rad);
     let mut wanted: BTreeMap<u32, Expectation> = BTreeMap::new();
+    if resume.resumed() {
+        let kept = resume.state();
+        (asked, wanted) = (kept.asked.clone(), kept.wanted.clone());
+        edges.number_from(kept.numbered[0]);
+        lines.number_from(kept.numbered[1]);
+        dispatcher.number_from(kept.numbered[2]);
+        tracing::warn!(requests = asked.len(), expectations = wanted.len(), "resumed from the checkpoint");
+    }
     let max_age_ns = args.expectation_max_age_ms * 1_000_000;
     let (mut processed, mut found) = (0u64, 0u64);
     while pace.next(&waiter, None)? != Step::Stop {
         expectations.drain(|e| {
-            wanted.insert(e.landmark_index, *e);
+            if resume.fresh(expectations.topic(), e.header.stamp_ns, e.header.seq) {
+                wanted.insert(e.landmark_index, *e);
+            }
         })?;
         requests.drain(|r| {
-            if r.request_id % n == k {
+            if r.request_id % n == k && resume.fresh(requests.topic(), r.header.stamp_ns, r.header.seq) {
                 asked.insert(r.request_id, *r);
             }
         })?;
         // Work on the newest frame only: a late worker skips, it does not fall further behind.
-        let Some(frame) = frames.latest()? else {
+        let frame =
+            frames.latest()?.filter(|f| resume.fresh(frames.topic(), f.header().stamp_ns, f.header().seq));
+        let Some(frame) = frame else {
+            keep(&mut resume, &asked, &wanted, [edges.numbered(), lines.numbered(), dispatcher.numbered()])?;
             pace.done()?;
             continue;
         };
@@ -132,6 +177,7 @@ fn main() -> anyhow::Result<()> {
         }
         asked.retain(|_, r| r.standing != 0);
         drop(frame);
+        keep(&mut resume, &asked, &wanted, [edges.numbered(), lines.numbered(), dispatcher.numbered()])?;
         pace.done()?;
     }
     tracing::info!(processed, found, "vision workers stopped");
