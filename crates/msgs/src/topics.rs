@@ -23,8 +23,12 @@ pub struct Qos {
 }
 
 impl Qos {
-    /// Small fixed-size messages: a few consumers plus the recorder and tools.
-    pub const STATE: Qos = Qos { buffer: 16, borrowed: 2, history: 1, max_publishers: 4, max_subscribers: 8 };
+    /// Small fixed-size messages: a few consumers plus the recorder and tools. A whole queue's
+    /// worth of history: a restarted consumer is handed the newest messages again (the
+    /// supervisor's re-offer), as many as a tick may bring (several sightings per frame, several
+    /// expectations per map), and drops those its checkpoint says it has taken.
+    pub const STATE: Qos =
+        Qos { buffer: 16, borrowed: 2, history: 16, max_publishers: 4, max_subscribers: 8 };
     /// Camera frames: every slot costs a whole frame of shared memory, so keep them few:
     /// 3 subscribers x (2 queued + 1 held) + 1 loaned + 1 history = 11 frames (68 MB at 1080p
     /// rgb8, 3.4 MB at 640x480 mono8). The history frame is what a restarted consumer is

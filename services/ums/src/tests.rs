@@ -214,7 +214,8 @@ fn a_restored_ums_goes_on_as_the_original_would() {
     // A fresh UMS would not go on so: it starts from the start's point.
     let fresh = ums().on_odometry(&odo(13 * 50, 13.0 * 0.2)).expect("ok");
     for k in 13..=30 {
-        let (x, y) = (a.on_odometry(&odo(k * 50, k as f64 * 0.2)), b.on_odometry(&odo(k * 50, k as f64 * 0.2)));
+        let (x, y) =
+            (a.on_odometry(&odo(k * 50, k as f64 * 0.2)), b.on_odometry(&odo(k * 50, k as f64 * 0.2)));
         let (x, y) = (x.expect("ok"), y.expect("ok"));
         if k == 13 {
             assert_ne!(map_of(&fresh), map_of(&y));
