@@ -1,9 +1,9 @@
 //! Services killed with SIGKILL in the middle of the default mission (deterministic), through
 //! `harvey chaos`, each run judged against a run without kills (issue 20): the simulated DRV
 //! and the bridge come back as the same robot and the same line; the encoders, the sonar, the
-//! camera, the vision workers and the UMS resume their checkpointed state and find the inputs of
-//! the tick they missed (every process re-offers first): in each case the recording is identical
-//! to the run without kills.
+//! camera, the vision workers and the UMS resume their checkpointed state, the executive runs its
+//! journal of inputs again, and each finds the inputs of the tick it missed (every process
+//! re-offers first): in each case the recording is identical to the run without kills.
 //! A restarted recorder continues its recording, losing at most half a second. On the code
 //! before, the bridge's and the DRV's restarts hung the chain, the encoders' ended the mission
 //! 1.8 m from where it should, the others' recordings differed, and the recorder's truncated
@@ -95,7 +95,7 @@ fn the_simulated_drv_and_the_bridge_come_back_and_the_recording_is_identical() {
 
 #[test]
 fn restarted_parties_resume_their_state_and_the_recording_is_identical() {
-    let (rows, log) = chaos("rs-state", "encoders,sonar,camera,vision-workers,ums", 6, 5);
+    let (rows, log) = chaos("rs-state", "encoders,sonar,camera,vision-workers,ums,executive", 7, 5);
     came_back_and_succeeded(&rows, &log);
     for r in &rows {
         assert!(r.identical, "{r:?}\n{log}");

@@ -6,10 +6,12 @@
 //! started by hand (no variable) skips the handshake.
 
 pub mod checkpoint;
+pub mod journal;
 pub mod resume;
 
 pub use checkpoint::{Checkpoint, CheckpointError, STATE_DIR_ENV};
-pub use resume::Resume;
+pub use journal::Journal;
+pub use resume::{Marks, Resume};
 
 use std::io::Write;
 use std::os::fd::FromRawFd;

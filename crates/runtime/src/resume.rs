@@ -20,11 +20,35 @@ use crate::checkpoint::{Checkpoint, CheckpointError};
 /// (stamp, seq) of a message: the order a topic's messages come in.
 type Mark = (u64, u64);
 
+/// The newest (stamp, seq) taken from each topic: what a restarted service is handed again
+/// and must drop. A topic's messages are taken to come in (stamp, seq) order (one publisher per
+/// topic, or publishers that stamp apart).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, serde::Deserialize)]
+pub struct Marks(BTreeMap<String, Mark>);
+
+impl Marks {
+    /// Whether a message on `topic` is news (and notes it taken).
+    pub fn fresh(&mut self, topic: &str, stamp_ns: u64, seq: u64) -> bool {
+        let m = (stamp_ns, seq);
+        match self.0.get_mut(topic) {
+            Some(last) if m <= *last => false,
+            Some(last) => {
+                *last = m;
+                true
+            }
+            None => {
+                self.0.insert(topic.to_owned(), m);
+                true
+            }
+        }
+    }
+}
+
 /// A service's state with what it has taken.
 pub struct Resume<S> {
     checkpoint: Option<Checkpoint>,
     state: S,
-    taken: BTreeMap<String, Mark>,
+    taken: Marks,
     resumed: bool,
 }
 
@@ -43,11 +67,10 @@ impl<S: Serialize + DeserializeOwned> Resume<S> {
         mut checkpoint: Option<Checkpoint>,
         fresh: impl FnOnce() -> S,
     ) -> Result<Self, CheckpointError> {
-        let saved =
-            checkpoint.as_mut().map(|c| c.load::<(S, BTreeMap<String, Mark>)>()).transpose()?.flatten();
+        let saved = checkpoint.as_mut().map(|c| c.load::<(S, Marks)>()).transpose()?.flatten();
         Ok(match saved {
             Some((state, taken)) => Self { checkpoint, state, taken, resumed: true },
-            None => Self { checkpoint, state: fresh(), taken: BTreeMap::new(), resumed: false },
+            None => Self { checkpoint, state: fresh(), taken: Marks::default(), resumed: false },
         })
     }
 
@@ -62,18 +85,7 @@ impl<S: Serialize + DeserializeOwned> Resume<S> {
 
     /// Whether an input on `topic` is news to the state (and notes it taken).
     pub fn fresh(&mut self, topic: &str, stamp_ns: u64, seq: u64) -> bool {
-        let m = (stamp_ns, seq);
-        match self.taken.get_mut(topic) {
-            Some(last) if m <= *last => false,
-            Some(last) => {
-                *last = m;
-                true
-            }
-            None => {
-                self.taken.insert(topic.to_owned(), m);
-                true
-            }
-        }
+        self.taken.fresh(topic, stamp_ns, seq)
     }
 
     /// The tick is finished: the state and what it has taken are saved.

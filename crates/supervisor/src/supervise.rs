@@ -68,11 +68,13 @@ pub fn supervise(
     }
 }
 
-/// A service exited at `now`: the launch ends if it was the `end_with` service or its policy
-/// gives up; otherwise its restart, if any, is scheduled.
+/// A service exited at `now`: the launch ends if it was the `end_with` service (unless a signal
+/// killed it and its policy restarts it: a crash is not the mission's end) or its policy gives
+/// up; otherwise its restart, if any, is scheduled.
 fn exited(slot: &mut Slot, status: ExitStatus, now: Instant, end_with: Option<&str>) -> Option<Outcome> {
     let name = slot.name().to_owned();
-    if end_with == Some(name.as_str()) {
+    let crashed = std::os::unix::process::ExitStatusExt::signal(&status).is_some();
+    if end_with == Some(name.as_str()) && !(crashed && slot.spec.restart != crate::Restart::Never) {
         tracing::info!(service = %name, "ended with {}", describe(status));
         return Some(Outcome::Ended { service: name, code: status.code().unwrap_or(1) });
     }

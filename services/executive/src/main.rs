@@ -7,7 +7,8 @@ use std::path::PathBuf;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_executive::{Executive, Output, setup};
-use harvey_msgs::{MissionState, topics};
+use harvey_msgs::{MissionState, Odometry, SonarRing, UncertaintyMap, VisionResult, topics};
+use harvey_runtime::{Journal, Marks};
 
 #[derive(Parser)]
 #[command(about = "Mission executive")]
@@ -21,6 +22,93 @@ struct Args {
     /// Seed of the noise motor schema.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+}
+
+/// One tick's inputs, as the executive takes them.
+#[derive(Default)]
+struct Tick {
+    rings: Vec<SonarRing>,
+    detections: u64,
+    /// (stamp, seq) of the newest detection counted (the executive counts them only).
+    newest_detection: Option<(u64, u64)>,
+    maps: Vec<UncertaintyMap>,
+    results: Vec<VisionResult>,
+    odos: Vec<Odometry>,
+}
+
+/// A tick's inputs in the journal, each message as its CDR.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Journaled {
+    rings: Vec<Vec<u8>>,
+    detections: u64,
+    newest_detection: Option<(u64, u64)>,
+    maps: Vec<Vec<u8>>,
+    results: Vec<Vec<u8>>,
+    odos: Vec<Vec<u8>>,
+}
+
+impl Journaled {
+    fn encode(t: &Tick) -> Self {
+        fn cdr<T: harvey_cdr::Cdr>(v: &[T]) -> Vec<Vec<u8>> {
+            v.iter().map(|m| harvey_cdr::encode(m, Vec::new())).collect()
+        }
+        Self {
+            rings: cdr(&t.rings),
+            detections: t.detections,
+            newest_detection: t.newest_detection,
+            maps: cdr(&t.maps),
+            results: cdr(&t.results),
+            odos: cdr(&t.odos),
+        }
+    }
+
+    /// The tick back, its messages noted taken.
+    fn decode(&self, marks: &mut Marks) -> anyhow::Result<Tick> {
+        fn back<T: harvey_cdr::Cdr + harvey_msgs::Message>(
+            v: &[Vec<u8>],
+            topic: &str,
+            marks: &mut Marks,
+        ) -> anyhow::Result<Vec<T>> {
+            v.iter()
+                .map(|b| {
+                    let m: T =
+                        harvey_cdr::decode(b).map_err(|e| anyhow::anyhow!("the journal's {topic}: {e}"))?;
+                    marks.fresh(topic, m.header().stamp_ns, m.header().seq);
+                    Ok(m)
+                })
+                .collect()
+        }
+        if let Some((stamp, seq)) = self.newest_detection {
+            marks.fresh(topics::VISION_DETECTIONS.name, stamp, seq);
+        }
+        Ok(Tick {
+            rings: back(&self.rings, topics::SONAR_RING.name, marks)?,
+            detections: self.detections,
+            newest_detection: self.newest_detection,
+            maps: back(&self.maps, topics::UMS_MAP.name, marks)?,
+            results: back(&self.results, topics::VISION_RESULTS.name, marks)?,
+            odos: back(&self.odos, topics::ODOMETRY.name, marks)?,
+        })
+    }
+}
+
+/// The executive's turn on one tick's inputs.
+fn step(exec: &mut Executive, t: &Tick) -> Vec<Output> {
+    for r in &t.rings {
+        exec.on_sonar(r);
+    }
+    exec.on_detections(t.detections);
+    for m in &t.maps {
+        exec.on_map(m);
+    }
+    let mut out = Vec::new();
+    for r in &t.results {
+        out.extend(exec.on_vision(r));
+    }
+    for o in &t.odos {
+        out.extend(exec.on_odometry(o));
+    }
+    out
 }
 
 fn main() -> anyhow::Result<()> {
@@ -49,31 +137,47 @@ fn main() -> anyhow::Result<()> {
     let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps, &results])?;
     harvey_runtime::notify_ready()?;
 
-    let (mut odos, mut seen, mut rings, mut map_batch) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let mut out = Vec::new();
+    // A restarted executive is rebuilt by running its predecessor's inputs through it again
+    // (its plans and behaviours are too rich to checkpoint; the logic is deterministic).
+    let mut marks = Marks::default();
+    let mut journal = match Journal::from_env::<Journaled>("executive")? {
+        Some((journal, past)) => {
+            if !past.is_empty() {
+                let ticks = past.len();
+                for j in past {
+                    let tick = j.decode(&mut marks)?;
+                    let _ = step(&mut exec, &tick);
+                }
+                tracing::warn!(ticks, state = ?exec.state(), "resumed: the inputs of the ticks before run through again");
+            }
+            Some(journal)
+        }
+        None => None,
+    };
+    let mut tick = Tick::default();
     while exec.state() == MissionState::Running {
         if pace.next(&waiter, None)? == Step::Stop {
             tracing::warn!("stopped before the mission ended");
             return Ok(());
         }
-        sonar.drain_into(&mut rings)?;
-        for r in &rings {
-            exec.on_sonar(r);
-        }
-        exec.on_detections(detections.drain(|_| {})? as u64);
-        maps.drain_into(&mut map_batch)?;
-        for m in &map_batch {
-            exec.on_map(m);
-        }
-        results.drain_into(&mut seen)?;
-        odometry.drain_into(&mut odos)?;
-        out.clear();
-        for r in &seen {
-            out.extend(exec.on_vision(r));
-        }
-        for o in &odos {
-            out.extend(exec.on_odometry(o));
-        }
+        let fresh =
+            |marks: &mut Marks, topic: &str, h: &harvey_msgs::Header| marks.fresh(topic, h.stamp_ns, h.seq);
+        sonar.drain_into(&mut tick.rings)?;
+        tick.rings.retain(|m| fresh(&mut marks, sonar.topic(), &m.header));
+        let (mut n, mut newest) = (0, None);
+        detections.drain(|d| {
+            if fresh(&mut marks, detections.topic(), &d.header) {
+                (n, newest) = (n + 1, Some((d.header.stamp_ns, d.header.seq)));
+            }
+        })?;
+        (tick.detections, tick.newest_detection) = (n, newest);
+        maps.drain_into(&mut tick.maps)?;
+        tick.maps.retain(|m| fresh(&mut marks, maps.topic(), &m.header));
+        results.drain_into(&mut tick.results)?;
+        tick.results.retain(|m| fresh(&mut marks, results.topic(), &m.header));
+        odometry.drain_into(&mut tick.odos)?;
+        tick.odos.retain(|m| fresh(&mut marks, odometry.topic(), &m.header));
+        let out = step(&mut exec, &tick);
         for o in &out {
             match o {
                 Output::Command(c) => {
@@ -105,6 +209,9 @@ fn main() -> anyhow::Result<()> {
                     behaviour_pub.send(b)?;
                 }
             }
+        }
+        if let Some(j) = journal.as_mut() {
+            j.append(&Journaled::encode(&tick))?;
         }
         pace.done()?;
     }
