@@ -26,6 +26,7 @@ struct Row {
     extra: usize,
     end_apart_m: f64,
     shm_left: usize,
+    missed: bool,
 }
 
 fn chaos(tag: &str, services: &str, kills: usize, seed: u64) -> (Vec<Row>, String) {
@@ -67,6 +68,7 @@ fn rows(csv: &Path, log: &str) -> Vec<Row> {
                 extra: f[8].parse().expect("extra"),
                 end_apart_m: f[10].parse().expect("end apart"),
                 shm_left: f[11].parse().expect("shm"),
+                missed: f[12] == "true",
             }
         })
         .collect()
@@ -75,6 +77,7 @@ fn rows(csv: &Path, log: &str) -> Vec<Row> {
 fn came_back_and_succeeded(rows: &[Row], log: &str) {
     assert!(!rows.is_empty(), "{log}");
     for r in rows {
+        assert!(!r.missed, "the kill landed in the mission: {r:?}\n{log}");
         assert_eq!(r.exit_code, Some(0), "{r:?}\n{log}");
         assert!(r.back_ms.is_some_and(|ms| ms < 2_000.0), "{r:?}\n{log}");
         assert_eq!(r.shm_left, 0, "{r:?}");

@@ -78,16 +78,17 @@ pub fn run(args: &ChaosArgs) -> anyhow::Result<i32> {
         reference.exit_code,
         reference.dir.display()
     );
-    let span = reference.mission_wall;
+    // Kills land at simulated times (the ticks they hit do not depend on the machine's speed).
+    let span_ns = report::last_truth_ns(&reference.dir.join("run.mcap"))?;
     let mut rng = Rng::new(args.seed);
     let mut runs = Vec::new();
     let n_runs = args.kills.div_ceil(args.kills_per_run);
     for i in 0..n_runs {
         let k = args.kills_per_run.min(args.kills - i * args.kills_per_run);
         // Kill times within the middle of the mission, in order; victims drawn from the targets.
-        let mut plan: Vec<(Duration, String)> = (0..k)
+        let mut plan: Vec<(u64, String)> = (0..k)
             .map(|_| {
-                let at = span.mul_f64(0.1 + 0.7 * rng.uniform());
+                let at = (span_ns as f64 * (0.1 + 0.7 * rng.uniform())) as u64;
                 let who = targets[(rng.next_u64() % targets.len() as u64) as usize].clone();
                 (at, who)
             })
@@ -117,13 +118,13 @@ fn cpu_line() -> String {
     format!("{model}, {} cores", std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
 
-/// Launches the mission once, killing as `plan` says (times after every service is up).
+/// Launches the mission once, killing as `plan` says (at simulated times, from `sim/truth`).
 fn launch_once(
     exe: &Path,
     mission: &Path,
     dir: &Path,
     prefix: &str,
-    plan: &[(Duration, String)],
+    plan: &[(u64, String)],
 ) -> anyhow::Result<Run> {
     if dir.exists() {
         std::fs::remove_dir_all(dir)?;
@@ -155,15 +156,24 @@ fn launch_once(
         std::thread::sleep(POLL);
     };
     let mut kills = Vec::new();
-    for (at, who) in plan {
-        while up.elapsed() < *at && child.try_wait()?.is_none() {
-            std::thread::sleep(POLL);
+    if !plan.is_empty() {
+        let bus = harvey_bus::Bus::join_with_prefix("harvey-chaos", prefix)?;
+        let truth = bus.subscriber(harvey_msgs::topics::SIM_TRUTH)?;
+        let mut now_ns = 0;
+        for (at, who) in plan {
+            let at_s = *at as f64 * 1e-9;
+            while now_ns < *at && child.try_wait()?.is_none() && started.elapsed() < RUN_TIMEOUT {
+                if let Some(t) = truth.latest()? {
+                    now_ns = t.header.stamp_ns;
+                }
+                std::thread::sleep(POLL);
+            }
+            if child.try_wait()?.is_some() || now_ns < *at {
+                kills.push(Kill { service: who.clone(), at_s, back_ms: None, missed: true });
+                continue;
+            }
+            kills.push(kill_one(prefix, who, at_s));
         }
-        if child.try_wait()?.is_some() {
-            kills.push(Kill { service: who.clone(), at_s: at.as_secs_f64(), back_ms: None, missed: true });
-            continue;
-        }
-        kills.push(kill_one(prefix, who, *at));
     }
     let status = loop {
         if let Some(s) = child.try_wait()? {
@@ -181,7 +191,7 @@ fn launch_once(
 }
 
 /// SIGKILLs `who` and waits for its successor on the bus.
-fn kill_one(prefix: &str, who: &str, at: Duration) -> Kill {
+fn kill_one(prefix: &str, who: &str, at_s: f64) -> Kill {
     let find = || {
         harvey_bus::live_nodes(prefix)
             .unwrap_or_default()
@@ -189,7 +199,7 @@ fn kill_one(prefix: &str, who: &str, at: Duration) -> Kill {
             .find(|n| n.alive && n.name == who)
             .map(|n| n.pid)
     };
-    let mut k = Kill { service: who.to_owned(), at_s: at.as_secs_f64(), back_ms: None, missed: true };
+    let mut k = Kill { service: who.to_owned(), at_s, back_ms: None, missed: true };
     let Some(pid) = find() else { return k };
     if kill(Pid::from_raw(pid), Signal::SIGKILL).is_err() {
         return k;

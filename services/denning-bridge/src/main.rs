@@ -9,14 +9,16 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, FdSource, Lockstep, Publisher, Reoffers, Subscriber, Waiter, Wake};
-use harvey_denning_bridge::{
-    BridgeState, Outgoing, SHUTDOWN_STOP_ID, Source, WATCHDOG_STOP_ID, prioritise, to_drv,
-};
-use harvey_drv_protocol::serial::{make_raw, read_available, write_frame};
+use harvey_bus::{Bus, FdSource, Lockstep, Reoffers, Waiter, Wake};
+use harvey_denning_bridge::{BridgeState, SHUTDOWN_STOP_ID};
+use harvey_drv_protocol::serial::{make_raw, read_available};
 use harvey_drv_protocol::{Command, Decoder, Line, encode};
-use harvey_msgs::{EncodersRaw, MissionStatus, MotionCommand, SonarRaw, topics};
+use harvey_msgs::topics;
 use harvey_runtime::Checkpoint;
+
+mod link;
+
+use link::{Ended, Link, Ports, forward, publish, send};
 
 #[derive(Parser)]
 #[command(about = "Bridge between a Denning DRV serial line and the Harvey bus")]
@@ -135,77 +137,6 @@ fn open_line(device: &Path, wait: Duration) -> anyhow::Result<File> {
 /// How often a missing line is tried again.
 const REOPEN_POLL: Duration = Duration::from_millis(20);
 
-/// Why the loop over one connection ended.
-enum Ended {
-    Shutdown,
-    HungUp,
-}
-
-/// The line and the state that outlives it.
-struct Link<'a> {
-    port: File,
-    state: &'a mut BridgeState,
-    checkpoint: Option<&'a mut Checkpoint>,
-}
-
-impl Link<'_> {
-    fn save(&mut self) -> anyhow::Result<()> {
-        match self.checkpoint.as_deref_mut() {
-            Some(c) => Ok(c.save(&*self.state)?),
-            None => Ok(()),
-        }
-    }
-
-    fn send_raw(&mut self, frame: &str) -> anyhow::Result<()> {
-        if !write_frame(&mut self.port, frame.as_bytes())? {
-            tracing::error!(frame, "serial line full: frame not sent");
-        }
-        Ok(())
-    }
-}
-
-/// The bus ports of the bridge.
-struct Ports {
-    commands: Subscriber<MotionCommand>,
-    reflexes: Subscriber<MotionCommand>,
-    heartbeat: Subscriber<MissionStatus>,
-    encoders: Publisher<EncodersRaw>,
-    sonar: Publisher<SonarRaw>,
-}
-
-/// Sends the commands that arrived (each once, across restarts); in lockstep the round's lines
-/// are kept to send again. True if any came from the executive.
-fn forward(
-    link: &mut Link,
-    ports: &Ports,
-    batch: &mut Vec<MotionCommand>,
-    round: &mut Vec<String>,
-) -> anyhow::Result<bool> {
-    batch.clear();
-    // The reflexes' commands first: an urgent stop among them pre-empts the batch.
-    ports.reflexes.drain(|c| batch.push(*c))?;
-    let reflexes = batch.len();
-    ports.commands.drain(|c| batch.push(*c))?;
-    let executive = batch.len() > reflexes;
-    let mut i = 0;
-    batch.retain(|c| {
-        let source = if i < reflexes { Source::Reflexes } else { Source::Commands };
-        i += 1;
-        link.state.fresh_command(source, c)
-    });
-    for cmd in prioritise(batch) {
-        match link.state.latch.admit(&cmd).and_then(|()| to_drv(&cmd)) {
-            Ok(drv) => {
-                let frame = encode(&Line::Command(drv));
-                link.send_raw(&frame)?;
-                round.push(frame);
-            }
-            Err(refusal) => tracing::error!("refused: {refusal}"),
-        }
-    }
-    Ok(executive)
-}
-
 /// The bridge's loop over one connection, until shutdown or the line hangs up.
 fn run(
     args: &Args,
@@ -286,67 +217,7 @@ fn run(
                 tracing::debug!(?line, "a repeat of a line already published");
                 continue;
             }
-            publish(args, link, lockstep, ports, line)?;
+            publish(args.watchdog_ms, link, lockstep, ports, line)?;
         }
     }
-}
-
-/// Puts one line from the DRV on the bus.
-fn publish(
-    args: &Args,
-    link: &mut Link,
-    lockstep: &Option<Lockstep>,
-    ports: &Ports,
-    line: Line,
-) -> anyhow::Result<()> {
-    let out = match line {
-        Line::Report(r) => link.state.bridge.on_report(r),
-        Line::Tick { time_ms } => Outgoing::Tick { time_ms },
-        line @ (Line::Command(_) | Line::Sync { .. } | Line::Heartbeat { .. }) => {
-            tracing::warn!(?line, "ignoring a host frame echoed by the vehicle");
-            return Ok(());
-        }
-    };
-    let stamp_ns = match out {
-        Outgoing::Encoders(m) => {
-            ports.encoders.send(&m)?;
-            Some(m.header.stamp_ns)
-        }
-        Outgoing::Sonar(m) => {
-            ports.sonar.send(&m)?;
-            Some(m.header.stamp_ns)
-        }
-        Outgoing::Tick { time_ms } => {
-            match lockstep {
-                Some(l) => l.finish(time_ms * 1_000_000)?,
-                None => tracing::warn!(time_ms, "a tick mark from the DRV in real-time mode"),
-            }
-            None
-        }
-        Outgoing::Refused { id, reason } => {
-            tracing::error!(id, ?reason, "the DRV refused a command");
-            None
-        }
-        Outgoing::Accepted { id } => {
-            tracing::debug!(id, "the DRV accepted a command");
-            None
-        }
-    };
-    if stamp_ns.is_some_and(|t| link.state.watchdog.on_vehicle_time(t)) {
-        tracing::error!(
-            deadline_ms = args.watchdog_ms,
-            vehicle_ms = link.state.watchdog.now_ms(),
-            "no heartbeat from the executive: stopping the vehicle"
-        );
-        send(&mut link.port, &Line::Command(Command::Stop { id: WATCHDOG_STOP_ID }))?;
-    }
-    link.save()
-}
-
-/// Writes one frame to the DRV; a full line loses it, loudly.
-fn send(port: &mut File, line: &Line) -> anyhow::Result<()> {
-    if !write_frame(port, encode(line).as_bytes())? {
-        tracing::error!(?line, "serial line full: frame not sent");
-    }
-    Ok(())
 }

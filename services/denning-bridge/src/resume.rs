@@ -112,19 +112,20 @@ mod tests {
         }
     }
 
+    fn enc(time_ms: u64) -> Line {
+        Line::Report(Report::Encoders {
+            time_ms,
+            x_hundredths_ft: 0,
+            y_hundredths_ft: 0,
+            heading_tenths_deg: 0,
+            moving: false,
+            command_id: 0,
+        })
+    }
+
     #[test]
     fn a_tick_sent_again_is_dropped_and_the_next_is_not() {
         let mut s = BridgeState::new(0, 0);
-        let enc = |t| {
-            Line::Report(Report::Encoders {
-                time_ms: t,
-                x_hundredths_ft: 0,
-                y_hundredths_ft: 0,
-                heading_tenths_deg: 0,
-                moving: false,
-                command_id: 0,
-            })
-        };
         let sonar = |t| Line::Report(Report::Sonar { time_ms: t, bank: 0, ranges_tenths_ft: [0; 8] });
         assert!(s.fresh_from_drv(&enc(50)));
         // The simulator died after the encoders went out; it sends the whole tick again.
@@ -139,16 +140,6 @@ mod tests {
     #[test]
     fn a_restarted_bridge_publishes_again_what_its_predecessor_left_unclosed() {
         let mut s = BridgeState::new(0, 0);
-        let enc = |t| {
-            Line::Report(Report::Encoders {
-                time_ms: t,
-                x_hundredths_ft: 0,
-                y_hundredths_ft: 0,
-                heading_tenths_deg: 0,
-                moving: false,
-                command_id: 0,
-            })
-        };
         assert!(s.fresh_from_drv(&enc(50)));
         assert!(s.fresh_from_drv(&Line::Tick { time_ms: 50 }));
         assert!(s.fresh_from_drv(&enc(100)));

@@ -50,17 +50,7 @@ pub struct SimState {
 pub struct SimDrv {
     world: World,
     tick_ms: u64,
-    rng: Rng,
-    /// The sensors' own randomness (sonar imperfections), apart from the motion's.
-    sensor_rng: Rng,
-    time_ms: u64,
-    truth: Pose2,
-    encoders: Pose2,
-    motion: Option<Motion>,
-    last_command: u32,
-    next_bank: u8,
-    /// Which way this vehicle's drive train pulls (002 §3.2: drift): fixed per seed.
-    drift_sign: f64,
+    s: SimState,
 }
 
 impl SimDrv {
@@ -68,9 +58,7 @@ impl SimDrv {
         let mut rng = Rng::new(seed);
         let drift_sign = if rng.uniform() < 0.5 { -1.0 } else { 1.0 };
         let truth = world.start;
-        Self {
-            world,
-            tick_ms,
+        let s = SimState {
             rng,
             sensor_rng: Rng::new(seed ^ SENSOR_STREAM),
             time_ms: 0,
@@ -80,58 +68,47 @@ impl SimDrv {
             last_command: 0,
             next_bank: 0,
             drift_sign,
-        }
+        };
+        Self { world, tick_ms, s }
     }
 
     /// The vehicle's state now.
     pub fn state(&self) -> SimState {
-        SimState {
-            rng: self.rng.clone(),
-            sensor_rng: self.sensor_rng.clone(),
-            time_ms: self.time_ms,
-            truth: self.truth,
-            encoders: self.encoders,
-            motion: self.motion.clone(),
-            last_command: self.last_command,
-            next_bank: self.next_bank,
-            drift_sign: self.drift_sign,
-        }
+        self.s.clone()
     }
 
     /// Puts the vehicle back in a state [`SimDrv::state`] gave, in the same world.
     pub fn restore(&mut self, s: SimState) {
         self.world.set_time(s.time_ms as f64 / 1000.0);
-        (self.rng, self.sensor_rng, self.time_ms) = (s.rng, s.sensor_rng, s.time_ms);
-        (self.truth, self.encoders, self.motion) = (s.truth, s.encoders, s.motion);
-        (self.last_command, self.next_bank, self.drift_sign) = (s.last_command, s.next_bank, s.drift_sign);
+        self.s = s;
     }
 
     pub fn truth(&self) -> Pose2 {
-        self.truth
+        self.s.truth
     }
 
     pub fn time_ms(&self) -> u64 {
-        self.time_ms
+        self.s.time_ms
     }
 
     pub fn is_moving(&self) -> bool {
-        self.motion.is_some()
+        self.s.motion.is_some()
     }
 
     /// Abandons any motion at once, as the DRV's watchdog does (not a command: the last
     /// command's id stays in the reports).
     pub fn halt(&mut self) {
-        self.motion = None;
+        self.s.motion = None;
     }
 
     /// Accepts or refuses a command; the answer goes back on the line at once.
     pub fn handle(&mut self, cmd: Command) -> Report {
         // The terrain under the robot when the command starts (its meadow's, 002 §4).
-        let t = self.world.terrain_at(self.truth.x_m, self.truth.y_m).clone();
+        let t = self.world.terrain_at(self.s.truth.x_m, self.s.truth.y_m).clone();
         let r = self.world.robot.clone();
         let (id, motion) = match cmd {
             Command::Stop { id } => {
-                self.motion = None;
+                self.s.motion = None;
                 (id, None)
             }
             Command::Move { id, hundredths_ft } => {
@@ -139,15 +116,15 @@ impl SimDrv {
                 if ft.abs() > MAX_MOVE_FT {
                     return Report::Nak { id, reason: NakReason::OutOfRange };
                 }
-                if self.motion.is_some() {
+                if self.s.motion.is_some() {
                     return Report::Nak { id, reason: NakReason::Busy };
                 }
                 let m = motion::plan_move(
                     &t,
-                    &mut self.rng,
-                    self.drift_sign,
-                    self.truth,
-                    self.encoders,
+                    &mut self.s.rng,
+                    self.s.drift_sign,
+                    self.s.truth,
+                    self.s.encoders,
                     ft * FT,
                     r.speed_mps,
                 );
@@ -158,7 +135,7 @@ impl SimDrv {
                 if deg.abs() > MAX_TURN_DEG {
                     return Report::Nak { id, reason: NakReason::OutOfRange };
                 }
-                if self.motion.is_some() {
+                if self.s.motion.is_some() {
                     return Report::Nak { id, reason: NakReason::Busy };
                 }
                 let rate = r.turn_rate_degps.to_radians();
@@ -166,9 +143,9 @@ impl SimDrv {
                     id,
                     Some(motion::plan_turn(
                         &t,
-                        &mut self.rng,
-                        self.truth,
-                        self.encoders,
+                        &mut self.s.rng,
+                        self.s.truth,
+                        self.s.encoders,
                         deg.to_radians(),
                         rate,
                     )),
@@ -180,50 +157,50 @@ impl SimDrv {
                 if v.abs() > r.speed_mps * 1.5 || w.abs() > r.turn_rate_degps.to_radians() * 1.5 {
                     return Report::Nak { id, reason: NakReason::OutOfRange };
                 }
-                let drift = self.drift_sign
-                    * self.rng.normal(t.drift_deg_per_ft, t.drift_sd_deg_per_ft).to_radians()
+                let drift = self.s.drift_sign
+                    * self.s.rng.normal(t.drift_deg_per_ft, t.drift_sd_deg_per_ft).to_radians()
                     / FT;
                 let idle = v == 0.0 && w == 0.0;
                 (id, (!idle).then_some(Motion::Velocity { v_mps: v, w_radps: w, drift_rad_per_m: drift }))
             }
         };
-        self.motion = motion;
-        self.last_command = id;
+        self.s.motion = motion;
+        self.s.last_command = id;
         Report::Ack { id }
     }
 
     /// Advances time by one tick: moves, fires the next sonar bank, reports encoders.
     pub fn tick(&mut self) -> TickOutput {
-        self.time_ms += self.tick_ms;
+        self.s.time_ms += self.tick_ms;
         // Moving things are where their timetables put them now (no-op in a still world).
-        self.world.set_time(self.time_ms as f64 / 1000.0);
+        self.world.set_time(self.s.time_ms as f64 / 1000.0);
         let dt_s = self.tick_ms as f64 / 1000.0;
-        if let Some(m) = &mut self.motion {
-            let t = self.world.terrain_at(self.truth.x_m, self.truth.y_m);
+        if let Some(m) = &mut self.s.motion {
+            let t = self.world.terrain_at(self.s.truth.x_m, self.s.truth.y_m);
             let counts = motion::Counts::of(&self.world.robot);
-            let (truth, enc, finished) = motion::advance(m, t, counts, self.truth, self.encoders, dt_s);
-            self.truth = truth;
-            self.encoders = enc;
+            let (truth, enc, finished) = motion::advance(m, t, counts, self.s.truth, self.s.encoders, dt_s);
+            self.s.truth = truth;
+            self.s.encoders = enc;
             if finished {
-                self.motion = None;
+                self.s.motion = None;
             }
         }
-        let bank = self.next_bank;
-        self.next_bank = (bank + 1) % 3;
-        let ranges_tenths_ft = sonar::fire_bank(&self.world, self.truth, bank, &mut self.sensor_rng);
-        let heading_deg = self.encoders.heading_rad.to_degrees().rem_euclid(360.0);
+        let bank = self.s.next_bank;
+        self.s.next_bank = (bank + 1) % 3;
+        let ranges_tenths_ft = sonar::fire_bank(&self.world, self.s.truth, bank, &mut self.s.sensor_rng);
+        let heading_deg = self.s.encoders.heading_rad.to_degrees().rem_euclid(360.0);
         let reports = vec![
             Report::Encoders {
-                time_ms: self.time_ms,
-                x_hundredths_ft: (self.encoders.x_m / FT * 100.0).round() as i32,
-                y_hundredths_ft: (self.encoders.y_m / FT * 100.0).round() as i32,
+                time_ms: self.s.time_ms,
+                x_hundredths_ft: (self.s.encoders.x_m / FT * 100.0).round() as i32,
+                y_hundredths_ft: (self.s.encoders.y_m / FT * 100.0).round() as i32,
                 heading_tenths_deg: ((heading_deg * 10.0).round() as i32) % 3600,
-                moving: self.motion.is_some(),
-                command_id: self.last_command,
+                moving: self.s.motion.is_some(),
+                command_id: self.s.last_command,
             },
-            Report::Sonar { time_ms: self.time_ms, bank, ranges_tenths_ft },
+            Report::Sonar { time_ms: self.s.time_ms, bank, ranges_tenths_ft },
         ];
-        TickOutput { time_ms: self.time_ms, truth: self.truth, reports }
+        TickOutput { time_ms: self.s.time_ms, truth: self.s.truth, reports }
     }
 }
 

@@ -12,7 +12,7 @@ use harvey_recording::compare::{Record, read_records};
 #[derive(Debug, Clone)]
 pub struct Kill {
     pub service: String,
-    /// Seconds after every service was up.
+    /// Simulated time of the kill (s).
     pub at_s: f64,
     /// Kill to the successor on the bus, if it came back.
     pub back_ms: Option<f64>,
@@ -83,8 +83,8 @@ impl Run {
             .iter()
             .map(|k| match (k.missed, k.back_ms) {
                 (true, _) => format!("{} (gone already)", k.service),
-                (false, Some(ms)) => format!("{} at {:.1} s back in {ms:.0} ms", k.service, k.at_s),
-                (false, None) => format!("{} at {:.1} s NEVER BACK", k.service, k.at_s),
+                (false, Some(ms)) => format!("{} at t = {:.2} s back in {ms:.0} ms", k.service, k.at_s),
+                (false, None) => format!("{} at t = {:.2} s NEVER BACK", k.service, k.at_s),
             })
             .collect();
         let v = &self.verdict;
@@ -108,6 +108,13 @@ impl Run {
             self.shm_left
         )
     }
+}
+
+/// The stamp of a recording's last true pose: how long the mission ran in simulated time.
+pub fn last_truth_ns(recording: &Path) -> anyhow::Result<u64> {
+    let truth = |t: &str| t == harvey_msgs::topics::SIM_TRUTH.name;
+    let records = read_records(recording, &truth)?;
+    records.last().map(|r| r.log_time).ok_or_else(|| anyhow::anyhow!("{}: no sim/truth", recording.display()))
 }
 
 /// The last true pose of a recording.
@@ -204,12 +211,12 @@ pub fn table(runs: &[Run], reference: &Run, cpu: &str) -> String {
 /// One line per kill, for plotting.
 pub fn csv(runs: &[Run]) -> String {
     let mut out = String::from(
-        "run,service,at_s,back_ms,exit_code,identical,missing,missing_span_s,extra,first_difference_s,end_apart_m,shm_left\n",
+        "run,service,at_s,back_ms,exit_code,identical,missing,missing_span_s,extra,first_difference_s,end_apart_m,shm_left,missed\n",
     );
     for r in runs {
         for k in &r.kills {
             out += &format!(
-                "{},{},{:.3},{},{},{},{},{:.3},{},{},{},{}\n",
+                "{},{},{:.3},{},{},{},{},{:.3},{},{},{},{},{}\n",
                 r.dir.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                 k.service,
                 k.at_s,
@@ -221,7 +228,8 @@ pub fn csv(runs: &[Run]) -> String {
                 r.verdict.extra,
                 r.verdict.first_difference_s.map_or(String::new(), |t| format!("{t:.3}")),
                 r.verdict.end_apart_m.map_or(String::new(), |m| format!("{m:.4}")),
-                r.shm_left
+                r.shm_left,
+                k.missed
             );
         }
     }
