@@ -11,7 +11,7 @@ pub mod resume;
 
 pub use checkpoint::{Checkpoint, CheckpointError, STATE_DIR_ENV};
 pub use journal::Journal;
-pub use resume::{Marks, Resume};
+pub use resume::{Marks, Resume, Sent};
 
 use std::io::Write;
 use std::os::fd::FromRawFd;

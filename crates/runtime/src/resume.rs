@@ -4,11 +4,10 @@
 //! A restarted party recomputes the tick it was killed in from the state before it. Its
 //! subscribers are handed each topic's newest messages again (the supervisor has every
 //! publisher re-offer its history first); inputs at or before what the state has taken are
-//! dropped ([`Resume::fresh`]). Its outputs of that tick are all sent again: what a killed
-//! publisher had sent dies with its shared memory before anyone downstream takes it (in
-//! lockstep no later party has had its turn), so nothing is sent twice. The state and its
-//! inputs are saved together at tick boundaries ([`Resume::tick_done`]), before the tick is
-//! reported done.
+//! dropped ([`Resume::fresh`]). The state and its inputs are saved together at tick
+//! boundaries ([`Resume::tick_done`]), before the tick is reported done. What it sends is noted
+//! as it goes ([`Sent`]): a killed publisher's samples still reach their subscribers, so a
+//! recomputed output its predecessor had sent does not go out again.
 
 use std::collections::BTreeMap;
 
@@ -27,6 +26,11 @@ type Mark = (u64, u64);
 pub struct Marks(BTreeMap<String, Mark>);
 
 impl Marks {
+    /// Whether a message on `topic` is at or before the newest noted.
+    pub fn seen(&self, topic: &str, stamp_ns: u64, seq: u64) -> bool {
+        self.0.get(topic).is_some_and(|last| (stamp_ns, seq) <= *last)
+    }
+
     /// Whether a message on `topic` is news (and notes it taken).
     pub fn fresh(&mut self, topic: &str, stamp_ns: u64, seq: u64) -> bool {
         let m = (stamp_ns, seq);
@@ -92,6 +96,37 @@ impl<S: Serialize + DeserializeOwned> Resume<S> {
     pub fn tick_done(&mut self) -> Result<(), CheckpointError> {
         match self.checkpoint.as_mut() {
             Some(c) => c.save(&(&self.state, &self.taken)),
+            None => Ok(()),
+        }
+    }
+}
+
+/// What a service has sent on each topic, saved as each message goes: a restarted party
+/// recomputes the tick it was killed in, and what its predecessor had already sent of it (the
+/// samples outlive their publisher) must not go out twice.
+pub struct Sent {
+    checkpoint: Option<Checkpoint>,
+    marks: Marks,
+}
+
+impl Sent {
+    /// The marks a predecessor of `service` left (`<service>-sent.ckpt`), else none.
+    pub fn from_env(service: &str) -> Result<Self, CheckpointError> {
+        let mut checkpoint = Checkpoint::from_env(&format!("{service}-sent"), 16 << 10)?;
+        let marks = checkpoint.as_mut().map(|c| c.load::<Marks>()).transpose()?.flatten().unwrap_or_default();
+        Ok(Self { checkpoint, marks })
+    }
+
+    /// Whether a message on `topic` (or another key that numbers its own) still has to go out.
+    pub fn due(&self, topic: &str, stamp_ns: u64, seq: u64) -> bool {
+        !self.marks.seen(topic, stamp_ns, seq)
+    }
+
+    /// A message went out.
+    pub fn done(&mut self, topic: &str, stamp_ns: u64, seq: u64) -> Result<(), CheckpointError> {
+        self.marks.fresh(topic, stamp_ns, seq);
+        match self.checkpoint.as_mut() {
+            Some(c) => c.save(&self.marks),
             None => Ok(()),
         }
     }

@@ -167,6 +167,7 @@ fn main() -> anyhow::Result<()> {
     // stamp): checkpointed, a restarted camera numbers on and draws the same noise.
     let mut resume = harvey_runtime::Resume::from_env("camera", 4 << 10, || 0u64)?;
     cam.seq = *resume.state();
+    let mut sent = harvey_runtime::Sent::from_env("camera")?;
     harvey_runtime::notify_ready()?;
     let every = args.every.max(1);
     let mut poses = Vec::new();
@@ -174,7 +175,14 @@ fn main() -> anyhow::Result<()> {
         truth.drain_into(&mut poses)?;
         poses.retain(|t| resume.fresh(truth.topic(), t.header.stamp_ns, t.header.seq));
         for t in poses.iter().filter(|t| t.header.seq % every == 0) {
-            cam.shoot(t.world_from_robot, t.header.stamp_ns)?;
+            // A frame its predecessor sent before it was killed is not sent twice.
+            let (topic, stamp, seq) = (topics::CAMERA_FRAME.name, t.header.stamp_ns, cam.seq + 1);
+            if sent.due(topic, stamp, seq) {
+                cam.shoot(t.world_from_robot, stamp)?;
+                sent.done(topic, stamp, seq)?;
+            } else {
+                cam.seq += 1;
+            }
         }
         *resume.state() = cam.seq;
         resume.tick_done()?;

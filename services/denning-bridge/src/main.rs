@@ -72,8 +72,8 @@ fn main() -> anyhow::Result<()> {
     if resumed {
         tracing::warn!(synced_ms = ?state.synced, "resumed from the checkpoint");
         // What the predecessor left half read on the line goes: the DRV sends the whole tick
-        // again when the last round comes again.
-        state.forget_unfinished_tick();
+        // again when the last round comes again, and what the predecessor had published of it
+        // (its samples outlive it) is dropped as a repeat.
         nix::sys::termios::tcflush(&port, nix::sys::termios::FlushArg::TCIFLUSH)
             .with_context(|| format!("flushing {}", args.device.display()))?;
     }

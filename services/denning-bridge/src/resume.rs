@@ -76,14 +76,6 @@ impl BridgeState {
         true
     }
 
-    /// After this bridge's own restart: what its killed predecessor published of a tick it had
-    /// not closed with `TK` died with its shared memory before anyone took it, so the tick's
-    /// reports go out again when the DRV repeats them.
-    pub fn forget_unfinished_tick(&mut self) {
-        self.encoders_ms = self.encoders_ms.min(self.tick_ms);
-        self.sonar_ms = self.sonar_ms.min(self.tick_ms);
-    }
-
     /// Whether the chain's tick `t` still needs its `SY` (a resumed chain may report a tick
     /// twice).
     pub fn needs_sync(&self, t_ms: u64) -> bool {
@@ -135,19 +127,6 @@ mod tests {
         assert!(!s.fresh_from_drv(&Line::Tick { time_ms: 50 }));
         assert!(s.fresh_from_drv(&enc(100)));
         assert!(s.fresh_from_drv(&Line::Report(Report::Ack { id: 3 })), "answers are never repeats");
-    }
-
-    #[test]
-    fn a_restarted_bridge_publishes_again_what_its_predecessor_left_unclosed() {
-        let mut s = BridgeState::new(0, 0);
-        assert!(s.fresh_from_drv(&enc(50)));
-        assert!(s.fresh_from_drv(&Line::Tick { time_ms: 50 }));
-        assert!(s.fresh_from_drv(&enc(100)));
-        // Killed before tick 100's `TK`: its encoders went out on the dead bridge's ports.
-        s.forget_unfinished_tick();
-        assert!(s.fresh_from_drv(&enc(100)));
-        assert!(!s.fresh_from_drv(&enc(50)));
-        assert!(!s.fresh_from_drv(&Line::Tick { time_ms: 50 }));
     }
 
     #[test]

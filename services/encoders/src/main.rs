@@ -24,6 +24,7 @@ fn main() -> anyhow::Result<()> {
     if resume.resumed() {
         tracing::warn!("resumed from the checkpoint");
     }
+    let mut sent = harvey_runtime::Sent::from_env("encoders")?;
     harvey_runtime::notify_ready()?;
 
     let (mut reports, mut cmds) = (Vec::new(), Vec::new());
@@ -44,7 +45,11 @@ fn main() -> anyhow::Result<()> {
         for r in &reports {
             match resume.state().on_encoders(r) {
                 Ok(odo) => {
-                    odometry.send(&odo)?;
+                    let (topic, h) = (odometry.topic(), odo.header);
+                    if sent.due(topic, h.stamp_ns, h.seq) {
+                        odometry.send(&odo)?;
+                        sent.done(topic, h.stamp_ns, h.seq)?;
+                    }
                 }
                 Err(e) => tracing::warn!("dropping an encoder report: {e}"),
             }

@@ -8,7 +8,7 @@ use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_executive::{Executive, Output, setup};
 use harvey_msgs::{MissionState, Odometry, SonarRing, UncertaintyMap, VisionResult, topics};
-use harvey_runtime::{Journal, Marks};
+use harvey_runtime::{Journal, Marks, Sent};
 
 #[derive(Parser)]
 #[command(about = "Mission executive")]
@@ -22,6 +22,20 @@ struct Args {
     /// Seed of the noise motor schema.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+}
+
+/// Sends `m` unless a predecessor of this process sent it before it was killed.
+fn send<T: harvey_msgs::Message>(
+    sent: &mut Sent,
+    port: &harvey_bus::Publisher<T>,
+    m: &T,
+) -> anyhow::Result<()> {
+    let h = *m.header();
+    if sent.due(port.topic(), h.stamp_ns, h.seq) {
+        port.send(m)?;
+        sent.done(port.topic(), h.stamp_ns, h.seq)?;
+    }
+    Ok(())
 }
 
 /// One tick's inputs, as the executive takes them.
@@ -154,6 +168,7 @@ fn main() -> anyhow::Result<()> {
         }
         None => None,
     };
+    let mut sent = Sent::from_env("executive")?;
     let mut tick = Tick::default();
     while exec.state() == MissionState::Running {
         if pace.next(&waiter, None)? == Step::Stop {
@@ -188,25 +203,25 @@ fn main() -> anyhow::Result<()> {
                         angle_rad = c.angle_rad,
                         "command"
                     );
-                    commands.send(c)?;
+                    send(&mut sent, &commands, c)?;
                 }
                 Output::Look(r) => {
-                    requests.send(r)?;
+                    send(&mut sent, &requests, r)?;
                 }
                 Output::Status(s) => {
-                    status.send(s)?;
+                    send(&mut sent, &status, s)?;
                 }
                 Output::Servo(c) => {
-                    servo_pub.send(c)?;
+                    send(&mut sent, &servo_pub, c)?;
                 }
                 Output::Pose(p) => {
-                    pose_pub.send(p)?;
+                    send(&mut sent, &pose_pub, p)?;
                 }
                 Output::Plan(p) => {
-                    plan_pub.send(p)?;
+                    send(&mut sent, &plan_pub, p)?;
                 }
                 Output::Behaviour(b) => {
-                    behaviour_pub.send(b)?;
+                    send(&mut sent, &behaviour_pub, b)?;
                 }
             }
         }

@@ -3,9 +3,9 @@
 //! checkpointed every tick, so a restarted sonar service goes on where it was.
 
 use clap::Parser;
-use harvey_bus::{Bus, Pace, Step, Waiter};
+use harvey_bus::{Bus, Pace, Publisher, Step, Waiter};
 use harvey_msgs::{Message, topics};
-use harvey_runtime::Resume;
+use harvey_runtime::{Resume, Sent};
 use harvey_sonar::SonarRingBuilder;
 use harvey_sonar::avoid::{AvoidParams, PanicAvoid};
 
@@ -33,6 +33,17 @@ struct Args {
     /// panic-avoid).
     #[arg(long, default_value_t = 2.0)]
     avoid_dash_ft: f64,
+}
+
+/// Sends `m` unless a predecessor of this process sent it before it was killed; `key` names
+/// the numbering (the panic-stop and the panic-avoid number their commands apart).
+fn send<T: Message>(sent: &mut Sent, key: &str, port: &Publisher<T>, m: &T) -> anyhow::Result<()> {
+    let h = *m.header();
+    if sent.due(key, h.stamp_ns, h.seq) {
+        port.send(m)?;
+        sent.done(key, h.stamp_ns, h.seq)?;
+    }
+    Ok(())
 }
 
 /// Room for the ring, the reflexes' state and the marks.
@@ -65,6 +76,7 @@ fn main() -> anyhow::Result<()> {
         })
     });
     let mut resume = Resume::from_env("sonar", SLOT_BYTES, || (ring, avoid))?;
+    let mut sent = Sent::from_env("sonar")?;
     if resume.resumed() {
         tracing::warn!("resumed from the checkpoint");
     }
@@ -78,7 +90,7 @@ fn main() -> anyhow::Result<()> {
         for o in &poses {
             if let Some(c) = resume.state().1.as_mut().and_then(|a| a.on_odometry(o)) {
                 tracing::warn!(command = c.command_id, kind = c.kind, "panic-avoid");
-                command_pub.send(&c)?;
+                send(&mut sent, "panic-avoid", &command_pub, &c)?;
             }
         }
         for bank in &banks {
@@ -87,13 +99,13 @@ fn main() -> anyhow::Result<()> {
                 Ok(update) => {
                     let evade = avoid.as_mut().and_then(|a| a.on_ring(&update.ring));
                     if let Some(stop) = update.panic_stop {
-                        command_pub.send(&stop)?;
+                        send(&mut sent, "panic-stop", &command_pub, &stop)?;
                     }
                     if let Some(c) = evade {
                         tracing::warn!("panic-avoid: an object is bearing down; stopping to evade");
-                        command_pub.send(&c)?;
+                        send(&mut sent, "panic-avoid", &command_pub, &c)?;
                     }
-                    ring_pub.send(&update.ring)?;
+                    send(&mut sent, ring_pub.topic(), &ring_pub, &update.ring)?;
                     rings += 1;
                 }
                 Err(e) => tracing::warn!("dropping a sonar report: {e}"),

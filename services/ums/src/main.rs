@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::topics;
+use harvey_runtime::Sent;
 use harvey_ums::{Config, Output, Ums};
 
 #[derive(Parser)]
@@ -36,6 +37,20 @@ struct Args {
     /// How late a sighting may arrive and still be applied at its own stamp.
     #[arg(long, default_value_t = 2000)]
     history_ms: u64,
+}
+
+/// Sends `m` unless a predecessor of this process sent it before it was killed.
+fn send<T: harvey_msgs::Message>(
+    sent: &mut Sent,
+    port: &harvey_bus::Publisher<T>,
+    m: &T,
+) -> anyhow::Result<()> {
+    let h = *m.header();
+    if sent.due(port.topic(), h.stamp_ns, h.seq) {
+        port.send(m)?;
+        sent.done(port.topic(), h.stamp_ns, h.seq)?;
+    }
+    Ok(())
 }
 
 /// Room for the map, its history and the pending sightings.
@@ -76,6 +91,7 @@ fn main() -> anyhow::Result<()> {
     let mut ums = Ums::new(world, config);
     // The uncertainty as the last finished tick left it, for a restarted UMS.
     let mut resume = harvey_runtime::Resume::from_env("ums", SLOT_BYTES, || ums.state())?;
+    let mut sent = Sent::from_env("ums")?;
     if resume.resumed() {
         ums.restore(resume.state().clone());
         tracing::warn!(
@@ -106,8 +122,8 @@ fn main() -> anyhow::Result<()> {
                 Ok(out) => {
                     for x in out {
                         match x {
-                            Output::Map(m) => _ = map_pub.send(&m)?,
-                            Output::Expectation(e) => _ = expectations.send(&e)?,
+                            Output::Map(m) => send(&mut sent, &map_pub, &m)?,
+                            Output::Expectation(e) => send(&mut sent, &expectations, &e)?,
                             Output::Rejected(e) => tracing::warn!("rejected: {e}"),
                         }
                     }

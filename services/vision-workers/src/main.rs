@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::{Expectation, VisionAlgorithm, VisionRequest, topics};
-use harvey_runtime::Resume;
+use harvey_runtime::{Resume, Sent};
 use harvey_vision_workers::VerticalEdges;
 use harvey_vision_workers::dispatch::Dispatcher;
 use harvey_vision_workers::landmarks::LineLandmarks;
@@ -51,6 +51,20 @@ fn shard(text: &str) -> anyhow::Result<(u32, u32)> {
         Some((k, n)) if k < n => Ok((k, n)),
         _ => anyhow::bail!("--shard `{text}`: expected K/N with K < N, like 0/2"),
     }
+}
+
+/// Sends `m` unless a predecessor of this process sent it before it was killed.
+fn send<T: harvey_msgs::Message>(
+    sent: &mut Sent,
+    port: &harvey_bus::Publisher<T>,
+    m: &T,
+) -> anyhow::Result<()> {
+    let h = *m.header();
+    if sent.due(port.topic(), h.stamp_ns, h.seq) {
+        port.send(m)?;
+        sent.done(port.topic(), h.stamp_ns, h.seq)?;
+    }
+    Ok(())
 }
 
 /// Room for the requests and expectations in force.
@@ -99,6 +113,7 @@ fn main() -> anyhow::Result<()> {
     // force and its numbering. (The region tracker's and activity detector's frames are not
     // kept: a restarted worker's begin afresh.)
     let mut resume = Resume::from_env("vision-workers", SLOT_BYTES, Kept::default)?;
+    let mut sent = Sent::from_env("vision-workers")?;
     // Requests by id (ascending, so answers come in a fixed order); one-shot ones go once answered.
     let mut asked: BTreeMap<u32, VisionRequest> = BTreeMap::new();
     if let Some(range) = &args.lines {
@@ -159,7 +174,7 @@ fn main() -> anyhow::Result<()> {
         let h = *frame.header();
         match edges.run(&h, frame.pixels()) {
             Ok(d) => {
-                detections.send(&d)?;
+                send(&mut sent, &detections, &d)?;
                 processed += 1;
             }
             Err(e) => tracing::warn!("skipping a frame: {e}"),
@@ -169,11 +184,11 @@ fn main() -> anyhow::Result<()> {
         for e in wanted.values().filter(|_| args.landmarks) {
             if let Some(s) = lines.recognise(&h, frame.pixels(), e) {
                 found += u64::from(s.kind != 0);
-                sightings.send(&s)?;
+                send(&mut sent, &sightings, &s)?;
             }
         }
         for req in asked.values() {
-            results.send(&dispatcher.answer(&h, frame.pixels(), req))?;
+            send(&mut sent, &results, &dispatcher.answer(&h, frame.pixels(), req))?;
         }
         asked.retain(|_, r| r.standing != 0);
         drop(frame);
