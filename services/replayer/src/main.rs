@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, Lockstep, Waiter, Wake};
+use harvey_bus::{Bus, Lockstep, Reoffers, Waiter, Wake};
 use harvey_msgs::topics;
 use harvey_recording::Recording;
 use harvey_recording::ticks::{Input, for_each_tick};
@@ -35,12 +35,15 @@ struct Args {
 fn wait_for(
     lockstep: &Lockstep,
     waiter: &Waiter,
+    reoffers: &Reoffers,
     done: &mut Option<u64>,
     tick: Option<u64>,
     stall: Duration,
 ) -> anyhow::Result<bool> {
     while !done.is_some_and(|d| tick.is_none_or(|t| d >= t)) {
         let wake = waiter.wait(Some(stall))?;
+        // A party restarted: the replayed inputs' history goes to it (`harvey_bus` reoffer.rs).
+        reoffers.serve()?;
         lockstep.finished(|t| *done = Some(done.map_or(t, |d| d.max(t))))?;
         match wake {
             Wake::Shutdown => return Ok(false),
@@ -74,6 +77,8 @@ fn main() -> anyhow::Result<()> {
         .transpose()?;
     let waiter = Waiter::new()?;
     let _a = waiter.attach(lockstep.predecessor())?;
+    let reoffers = bus.reoffers();
+    let _b = waiter.attach(reoffers.as_ref())?;
     harvey_runtime::notify_ready()?;
     tracing::info!(
         ticks = contents.ticks,
@@ -84,14 +89,14 @@ fn main() -> anyhow::Result<()> {
 
     let stall = Duration::from_secs(args.stall_timeout_s.max(1));
     let mut done = None;
-    if !wait_for(&lockstep, &waiter, &mut done, None, stall)? {
+    if !wait_for(&lockstep, &waiter, &reoffers, &mut done, None, stall)? {
         return Ok(());
     }
     let started = Instant::now();
     let mut previous = None;
     let mut interrupted = false;
     for_each_tick(&recording, |stamp, inputs| {
-        if interrupted || !wait_for(&lockstep, &waiter, &mut done, previous, stall)? {
+        if interrupted || !wait_for(&lockstep, &waiter, &reoffers, &mut done, previous, stall)? {
             interrupted = true;
             return Ok(());
         }
@@ -123,7 +128,7 @@ fn main() -> anyhow::Result<()> {
         Ok(())
     })
     .with_context(|| args.recording.display().to_string())?;
-    if interrupted || !wait_for(&lockstep, &waiter, &mut done, previous, stall)? {
+    if interrupted || !wait_for(&lockstep, &waiter, &reoffers, &mut done, previous, stall)? {
         tracing::warn!("replay interrupted");
         return Ok(());
     }
