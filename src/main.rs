@@ -31,6 +31,13 @@ enum Cmd {
         #[command(flatten)]
         opts: LaunchArgs,
     },
+    /// The supervisor process of a launch, as its keeper starts it (not for direct use).
+    #[command(hide = true)]
+    Supervise {
+        file: PathBuf,
+        #[command(flatten)]
+        opts: LaunchArgs,
+    },
     /// Run a recording's services again on its recorded inputs (deterministically, as fast as
     /// they go) and record them again; `--check` compares the new recording with the old.
     Replay {
@@ -109,6 +116,7 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
     match cmd {
         Cmd::Run { mission, opts } => cmd::run::run(mission.as_deref(), &opts),
         Cmd::Launch { file, opts } => cmd::launch::run(&file, &opts),
+        Cmd::Supervise { file, opts } => cmd::launch::supervise(&file, &opts),
         Cmd::Replay { recording, check, rrd, trust_recording, opts } => {
             cmd::replay::run(&recording, check, rrd, trust_recording, opts)
         }

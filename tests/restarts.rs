@@ -7,7 +7,7 @@
 //! A restarted recorder continues its recording, losing at most half a second. On the code
 //! before, the bridge's and the DRV's restarts hung the chain, the encoders' ended the mission
 //! 1.8 m from where it should, the others' recordings differed, and the recorder's truncated
-//! its file.
+//! its file; a killed supervisor took every service down with it.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
@@ -30,6 +30,12 @@ struct Row {
 }
 
 fn chaos(tag: &str, services: &str, kills: usize, seed: u64) -> (Vec<Row>, String) {
+    let (rows, log, _) = chaos_in(tag, services, kills, seed);
+    (rows, log)
+}
+
+/// As [`chaos`], also giving the output folder (each run's `launch.log` is in `run-NNN/`).
+fn chaos_in(tag: &str, services: &str, kills: usize, seed: u64) -> (Vec<Row>, String, std::path::PathBuf) {
     let out = common::scratch(tag);
     let prefix = common::unique_prefix(tag);
     let run = common::harvey(&[
@@ -48,7 +54,7 @@ fn chaos(tag: &str, services: &str, kills: usize, seed: u64) -> (Vec<Row>, Strin
     .output()
     .expect("harvey chaos runs");
     let text = format!("{}{}", String::from_utf8_lossy(&run.stdout), String::from_utf8_lossy(&run.stderr));
-    (rows(&out.join("chaos.csv"), &text), text)
+    (rows(&out.join("chaos.csv"), &text), text, out)
 }
 
 fn rows(csv: &Path, log: &str) -> Vec<Row> {
@@ -114,5 +120,20 @@ fn a_restarted_recorder_continues_its_recording_losing_at_most_half_a_second() {
         assert_eq!(r.extra, 0, "nothing recorded twice: {r:?}\n{log}");
         assert!(r.missing_span_s <= 0.5, "{r:?}\n{log}");
         assert!(r.end_apart_m < 1e-9, "the recording goes on to the end: {r:?}");
+    }
+}
+
+#[test]
+fn a_killed_supervisor_is_replaced_by_one_that_takes_over_and_the_recording_is_identical() {
+    // The keeper starts the services, so they run on while no supervisor watches; the new
+    // supervisor takes them and the clock chain over where they are.
+    let (rows, log, out) = chaos_in("rs-sup", "supervisor", 2, 3);
+    came_back_and_succeeded(&rows, &log);
+    for (i, r) in rows.iter().enumerate() {
+        assert!(r.identical, "{r:?}\n{log}");
+        assert_eq!((r.missing, r.extra), (0, 0), "{r:?}");
+        let launch = std::fs::read_to_string(out.join(format!("run-{i:03}/launch.log"))).expect("launch.log");
+        assert!(launch.contains("taking over from a supervisor that died"), "{launch}");
+        assert!(!launch.contains("restarted"), "no service was started again: {launch}");
     }
 }

@@ -31,7 +31,7 @@ pub struct ChaosArgs {
     /// Seed of the kill times and victims.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Services to kill (default: every service the launch restarts).
+    /// Services to kill (default: every service the launch restarts, and `supervisor`).
     #[arg(long, value_delimiter = ',')]
     pub services: Vec<String>,
     /// Output folder: the runs, chaos.md and chaos.csv.
@@ -41,6 +41,9 @@ pub struct ChaosArgs {
     #[arg(long, default_value = "chaos")]
     pub prefix: String,
 }
+
+/// The kill target that is the launch's supervisor process (its keeper starts a new one).
+const SUPERVISOR: &str = "supervisor";
 
 /// How long a service may stay gone before the harness stops waiting for it.
 const BACK_TIMEOUT: Duration = Duration::from_secs(30);
@@ -56,12 +59,13 @@ pub fn run(args: &ChaosArgs) -> anyhow::Result<i32> {
         .iter()
         .filter(|s| s.restart != harvey_supervisor::Restart::Never)
         .map(|s| s.name().to_owned())
+        .chain([SUPERVISOR.to_owned()])
         .collect();
     let targets = if args.services.is_empty() { restartable.clone() } else { args.services.clone() };
     for t in &targets {
         anyhow::ensure!(
             restartable.contains(t),
-            "{}: `{t}` is not a service the launch restarts (it restarts {restartable:?})",
+            "{}: `{t}` is not a service the launch restarts (it restarts {restartable:?}, `{SUPERVISOR}` included)",
             mission.display()
         );
     }
@@ -190,13 +194,15 @@ fn launch_once(
     Ok(Run::new(dir, status.and_then(|s| s.code()), up.elapsed(), kills, leftovers))
 }
 
-/// SIGKILLs `who` and waits for its successor on the bus.
+/// SIGKILLs `who` and waits for its successor on the bus (the supervisor's node is its clock
+/// watch, `harvey-supervisor`).
 fn kill_one(prefix: &str, who: &str, at_s: f64) -> Kill {
+    let node = if who == SUPERVISOR { "harvey-supervisor" } else { who };
     let find = || {
         harvey_bus::live_nodes(prefix)
             .unwrap_or_default()
             .into_iter()
-            .find(|n| n.alive && n.name == who)
+            .find(|n| n.alive && n.name == node)
             .map(|n| n.pid)
     };
     let mut k = Kill { service: who.to_owned(), at_s, back_ms: None, missed: true };

@@ -3,10 +3,22 @@
 
 use std::path::Path;
 
-use super::{LaunchArgs, launch_file};
+use super::{LaunchArgs, launch_file, launch_options};
 
 pub fn run(file: &Path, opts: &LaunchArgs) -> anyhow::Result<i32> {
     let (outcome, _) = launch_file(file, opts)?;
     println!("launch: {outcome:?}");
+    Ok(outcome.exit_code())
+}
+
+/// `harvey supervise FILE`: the supervisor process of a launch, started by its keeper (the
+/// `harvey run`/`launch`/`replay` process) with the keeper's line on an inherited descriptor.
+pub fn supervise(file: &Path, args: &LaunchArgs) -> anyhow::Result<i32> {
+    let Some(mut line) = harvey_supervisor::KeeperLine::from_env()? else {
+        anyhow::bail!("`harvey supervise` runs under a keeper: use `harvey launch {}`", file.display());
+    };
+    let lf = harvey_supervisor::LaunchFile::load(file)?;
+    let outcome = harvey_supervisor::run(&lf, &launch_options(&lf, args), &mut line)?;
+    line.report(&outcome)?;
     Ok(outcome.exit_code())
 }

@@ -25,13 +25,31 @@ pub struct LaunchArgs {
     pub prefix: String,
 }
 
-/// Runs launch file `file` under the supervisor; returns how it ended and its run folder.
+/// Where launch file `lf` runs, given `args`.
+fn launch_options(lf: &harvey_supervisor::LaunchFile, args: &LaunchArgs) -> harvey_supervisor::Options {
+    let run_dir = args.run_dir.clone().unwrap_or_else(|| Path::new("recordings").join(&lf.settings.name));
+    harvey_supervisor::Options { prefix: args.prefix.clone(), run_dir }
+}
+
+/// Runs launch file `file` under the keeper, which runs the supervisor (`harvey supervise`) as
+/// its child and a new one if that dies; returns how the launch ended and its run folder. A
+/// supervisor that failed has said why: this process exits with its code.
 fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervisor::Outcome, PathBuf)> {
     let lf = harvey_supervisor::LaunchFile::load(file)?;
-    let run_dir = args.run_dir.clone().unwrap_or_else(|| Path::new("recordings").join(&lf.settings.name));
-    let opts = harvey_supervisor::Options { prefix: args.prefix.clone(), run_dir: run_dir.clone() };
-    tracing::info!(launch = %lf.settings.name, run_dir = %run_dir.display(), prefix = %opts.prefix, "launching {} services", lf.services.len());
-    Ok((harvey_supervisor::run(&lf, &opts)?, run_dir))
+    let opts = launch_options(&lf, args);
+    harvey_bus::validate_prefix(&opts.prefix)?;
+    tracing::info!(launch = %lf.settings.name, run_dir = %opts.run_dir.display(), prefix = %opts.prefix, "launching {} services", lf.services.len());
+    let exe = std::env::current_exe()?;
+    let make = || {
+        let mut cmd = std::process::Command::new(&exe);
+        cmd.arg("supervise").arg(file).arg("--run-dir").arg(&opts.run_dir).args(["--prefix", &opts.prefix]);
+        cmd
+    };
+    let grace = std::time::Duration::from_millis(lf.settings.grace_period_ms);
+    match harvey_supervisor::keep(&make, grace)? {
+        harvey_supervisor::Kept::Outcome(o) => Ok((o, opts.run_dir)),
+        harvey_supervisor::Kept::Failed(code) => std::process::exit(code),
+    }
 }
 
 /// Prints the outcome of a comparison; the exit code is 0 when the recordings agree.

@@ -31,8 +31,8 @@ pub enum SupervisorError {
     Signals(#[source] std::io::Error),
     #[error(transparent)]
     Spawn(#[from] SpawnError),
-    #[error("waiting for a child")]
-    Wait(#[source] std::io::Error),
+    #[error("the supervisor's keeper: {0}")]
+    Keeper(String),
 }
 
 /// `e` and its sources, joined by `: ` (what `{:#}` shows for an `anyhow` error).

@@ -4,19 +4,26 @@
 //!
 //! - [`config`] and [`LaunchFile`]: the launch-file format, checked with file, line and key.
 //! - [`policy`]: the restart policy as pure state, fed with instants and exits.
-//! - `child`: the thin spawn layer (process group, readiness pipe, PDEATHSIG, prefixed logs,
-//!   stop with grace); `supervise`: the loop that ties them together.
+//! - [`keep`]: the keeper, the launch's outer process: it starts every process (`spawn`), reaps
+//!   them, and starts a new supervisor when one dies (`link`: the line between the two).
+//! - `child` and `keeper_line`: the supervisor's side of a service process (spawned by the
+//!   keeper, waited for until ready, stopped with grace); `supervise`: the loop that ties
+//!   policy, clock and children together.
 
 pub mod bounds;
 mod child;
 mod clock;
 pub mod config;
 mod error;
+mod keeper;
+mod keeper_line;
 mod launch_file;
+mod link;
 mod outcome;
 pub mod policy;
 mod signals;
 mod slots;
+mod spawn;
 mod supervise;
 mod supervisor;
 mod wait;
@@ -24,6 +31,8 @@ mod wait;
 pub use child::SpawnError;
 pub use config::{LaunchError, LaunchFile};
 pub use error::SupervisorError;
+pub use keeper::{Kept, keep};
+pub use keeper_line::KeeperLine;
 pub use outcome::{Options, Outcome};
 pub use policy::{Decision, Restart, RestartPolicy, RestartRules};
 pub use slots::find_binary;

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 /// How a launch ended.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Outcome {
     /// The `end_with` service exited with this code (0: the mission is done).
     Ended { service: String, code: i32 },

@@ -19,6 +19,12 @@ pub struct Signals {
 impl Signals {
     /// Installs the handlers.
     pub fn install() -> std::io::Result<Self> {
+        Self::install_waking(&[])
+    }
+
+    /// Installs the handlers, and makes `wake_only` signals (SIGCHLD for the keeper) wake the
+    /// pipe without counting as received.
+    pub fn install_waking(wake_only: &[i32]) -> std::io::Result<Self> {
         let flag = Arc::new(AtomicUsize::new(0));
         let (wake, ping) = nix::unistd::pipe2(OFlag::O_CLOEXEC | OFlag::O_NONBLOCK)?;
         let mut signals = Self { flag, wake, pipe_handlers: Vec::new() };
@@ -28,12 +34,21 @@ impl Signals {
             let id = signal_hook::low_level::pipe::register(sig, ping.try_clone()?)?;
             signals.pipe_handlers.push(id);
         }
+        for sig in wake_only {
+            let id = signal_hook::low_level::pipe::register(*sig, ping.try_clone()?)?;
+            signals.pipe_handlers.push(id);
+        }
         Ok(signals)
     }
 
     /// Whether SIGINT or SIGTERM arrived.
     pub fn received(&self) -> bool {
         self.flag.load(Ordering::Relaxed) != 0
+    }
+
+    /// The signal that arrived last, if any.
+    pub fn which(&self) -> Option<i32> {
+        Some(self.flag.load(Ordering::Relaxed) as i32).filter(|s| *s != 0)
     }
 
     /// Readable once a signal has arrived (until [`Signals::drain`]).

@@ -4,9 +4,11 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use crate::child::{self, Running, SpawnError};
+use crate::child::{self, Running};
 use crate::config::{LaunchFile, Service};
 use crate::error::SupervisorError;
+use crate::keeper_line::KeeperLine;
+use crate::link::SpawnSpec;
 use crate::outcome::Options;
 use crate::policy::RestartPolicy;
 
@@ -26,9 +28,15 @@ impl Slot {
         self.spec.name()
     }
 
-    /// Starts the service; returns once it is ready.
-    pub fn spawn(&self, ready: Duration) -> Result<Running, SpawnError> {
-        child::spawn(self.spec.name(), &self.binary, &self.args, &self.env, ready)
+    /// Has the keeper start the service; returns once it is ready.
+    pub fn spawn(&self, line: &mut KeeperLine, ready: Duration) -> Result<Running, SupervisorError> {
+        let spec = SpawnSpec {
+            name: self.name().to_owned(),
+            binary: self.binary.clone(),
+            args: self.args.clone(),
+            env: self.env.iter().map(|(k, v)| ((*k).to_owned(), v.clone())).collect(),
+        };
+        child::spawn(line, spec, ready)
     }
 }
 
@@ -59,16 +67,23 @@ fn absolute(p: &Path) -> PathBuf {
 
 /// Creates the run folder and prepares every service of `launch`, in order; `chain` is the
 /// clock chain. Fails, starting nothing, if the world file or an executable is missing.
-pub fn prepare(launch: &LaunchFile, opts: &Options, chain: &[String]) -> Result<Vec<Slot>, SupervisorError> {
+/// `fresh` empties the services' checkpoints (a new launch; not a supervisor taking over).
+pub fn prepare(
+    launch: &LaunchFile,
+    opts: &Options,
+    chain: &[String],
+    fresh: bool,
+) -> Result<Vec<Slot>, SupervisorError> {
     std::fs::create_dir_all(&opts.run_dir)
         .map_err(|source| SupervisorError::RunDir { path: opts.run_dir.clone(), source })?;
     // The services' checkpoints: a fresh launch starts from nothing, a restart from its own.
     let state_dir = opts.run_dir.join(STATE_DIR);
-    let fresh = match std::fs::remove_dir_all(&state_dir) {
+    let emptied = if fresh { std::fs::remove_dir_all(&state_dir) } else { Ok(()) };
+    let made = match emptied {
         Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(e),
         _ => std::fs::create_dir_all(&state_dir),
     };
-    fresh.map_err(|source| SupervisorError::RunDir { path: state_dir.clone(), source })?;
+    made.map_err(|source| SupervisorError::RunDir { path: state_dir.clone(), source })?;
     let mut vars = vec![
         ("run_dir", absolute(&opts.run_dir).display().to_string()),
         ("seed", launch.settings.seed.to_string()),

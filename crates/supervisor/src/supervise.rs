@@ -1,6 +1,7 @@
 //! The supervision loop: takes in exits, asks each service's restart policy what to do, restarts
 //! the services that are due, and sleeps until a child exits, a signal arrives or a restart is
-//! due. In lockstep mode it also samples the clock chain's progress every 10 ms.
+//! due (the keeper's line says when a child exits). In lockstep mode it also samples the clock
+//! chain's progress every 10 ms.
 
 use std::process::ExitStatus;
 use std::time::{Duration, Instant};
@@ -9,32 +10,34 @@ use crate::child::describe;
 use crate::clock::ClockWatch;
 use crate::config::LaunchFile;
 use crate::error::{SupervisorError, chain};
-use crate::outcome::Outcome;
+use crate::keeper_line::KeeperLine;
+use crate::outcome::{Options, Outcome};
 use crate::policy::Decision;
 use crate::signals::Signals;
 use crate::slots::Slot;
 use crate::wait::poll_input;
 
-/// How often the clock chain's progress is sampled, and how often children are checked where
-/// the kernel has no pidfds to wake the loop.
+/// How often the clock chain's progress is sampled.
 const POLL: Duration = Duration::from_millis(10);
 
 /// The longest the loop sleeps with nothing to wait for (a safety net: every wake-up it needs
 /// comes from a descriptor or a deadline).
 const MAX_WAIT: Duration = Duration::from_secs(1);
 
-/// Supervises the started services until the launch ends.
+/// Supervises the started services until the launch ends (at the latest after `time_left`).
 pub fn supervise(
     slots: &mut [Slot],
     launch: &LaunchFile,
-    prefix: &str,
+    opts: &Options,
     mut clock: Option<&mut ClockWatch>,
-    ready: Duration,
+    line: &mut KeeperLine,
+    time_left: Duration,
     signals: &Signals,
 ) -> Result<Outcome, SupervisorError> {
     let end_with = launch.settings.end_with.as_ref().map(|s| s.get_ref().clone());
     let limit_s = launch.settings.wall_limit_s;
-    let deadline = Instant::now() + Duration::from_secs(limit_s);
+    let ready = Duration::from_millis(launch.settings.ready_timeout_ms);
+    let deadline = Instant::now() + time_left;
     loop {
         if Instant::now() >= deadline {
             let waiting = clock.as_deref().map(|c| c.holder().0.to_owned());
@@ -49,9 +52,11 @@ pub fn supervise(
             return Ok(Outcome::Interrupted);
         }
         let now = Instant::now();
-        for slot in slots.iter_mut() {
-            let Some(r) = &mut slot.running else { continue };
-            let Some(status) = r.child.try_wait().map_err(SupervisorError::Wait)? else { continue };
+        for (pid, status) in line.exits()? {
+            let Some(slot) = slots.iter_mut().find(|s| s.running.as_ref().is_some_and(|r| r.pid == pid))
+            else {
+                continue;
+            };
             slot.running = None;
             if let Some(outcome) = exited(slot, status, now, end_with.as_deref()) {
                 return Ok(outcome);
@@ -59,12 +64,12 @@ pub fn supervise(
         }
         for i in 0..slots.len() {
             if slots[i].policy.take_due(now)
-                && let Some(outcome) = restart(slots, i, prefix, clock.as_deref_mut(), ready)?
+                && let Some(outcome) = restart(slots, i, &opts.prefix, clock.as_deref_mut(), line, ready)?
             {
                 return Ok(outcome);
             }
         }
-        wait_for_events(slots, signals, clock.is_some());
+        wait_for_events(slots, signals, line, clock.is_some());
     }
 }
 
@@ -102,13 +107,14 @@ fn restart(
     i: usize,
     prefix: &str,
     clock: Option<&mut ClockWatch>,
+    line: &mut KeeperLine,
     ready: Duration,
 ) -> Result<Option<Outcome>, SupervisorError> {
     let cleaned = harvey_bus::cleanup_dead_nodes(prefix)?;
     let slot = &mut slots[i];
-    match slot.spawn(ready) {
+    match slot.spawn(line, ready) {
         Ok(r) => {
-            tracing::info!(service = %r.name, pid = r.child.id(), cleaned, "restarted");
+            tracing::info!(service = %r.name, pid = r.pid, cleaned, "restarted");
             slot.running = Some(r);
             if let Some(c) = clock {
                 let name = slots[i].name().to_owned();
@@ -116,12 +122,13 @@ fn restart(
                     .iter()
                     .enumerate()
                     .filter(|(j, _)| *j != i)
-                    .filter_map(|(_, s)| s.running.as_ref().map(|r| r.child.id()))
+                    .filter_map(|(_, s)| s.running.as_ref().map(|r| r.pid))
                     .collect();
                 c.resume(&name, &others)?;
             }
             Ok(None)
         }
+        Err(e @ SupervisorError::Keeper(_)) => Err(e),
         Err(e) => {
             tracing::error!("{}", chain(&e));
             match slot.policy.on_failed_start(Instant::now()) {
@@ -132,21 +139,14 @@ fn restart(
     }
 }
 
-/// Sleeps until a child exits, a signal arrives or the next restart is due; at most [`POLL`]
-/// when the clock chain is sampled or a child has no pidfd.
-fn wait_for_events(slots: &[Slot], signals: &Signals, sampling: bool) {
-    let mut fds = vec![signals.wake_fd()];
-    let mut unwatched = false;
-    for r in slots.iter().filter_map(|s| s.running.as_ref()) {
-        match r.exit_fd() {
-            Some(fd) => fds.push(fd),
-            None => unwatched = true,
-        }
-    }
+/// Sleeps until the keeper reports an exit, a signal arrives or the next restart is due; at
+/// most [`POLL`] when the clock chain is sampled.
+fn wait_for_events(slots: &[Slot], signals: &Signals, line: &KeeperLine, sampling: bool) {
+    let fds = [signals.wake_fd(), line.fd()];
     let now = Instant::now();
     let next = slots.iter().filter_map(|s| s.policy.next_restart()).min();
     let mut timeout = next.map_or(MAX_WAIT, |t| t.saturating_duration_since(now).min(MAX_WAIT));
-    if sampling || unwatched {
+    if sampling {
         timeout = timeout.min(POLL);
     }
     match poll_input(&fds, Some(timeout)) {

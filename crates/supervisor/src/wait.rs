@@ -1,7 +1,7 @@
-//! Waiting on file descriptors: a child's readiness pipe (it writes `READY\n`), and a process's
-//! pidfd, which becomes readable when the process exits.
+//! Waiting on file descriptors: a child's readiness pipe (it writes `READY\n`), the keeper's
+//! line, a signal's self-pipe.
 
-use std::os::fd::{AsFd, BorrowedFd, FromRawFd, OwnedFd};
+use std::os::fd::{AsFd, BorrowedFd, OwnedFd};
 use std::time::{Duration, Instant};
 
 use nix::errno::Errno;
@@ -65,13 +65,4 @@ pub fn wait_ready(pipe: &OwnedFd, timeout: Duration) -> Result<(), NotReady> {
             return Ok(());
         }
     }
-}
-
-/// A pidfd of process `pid` (close-on-exec), or `None` where the kernel has none (before 5.3).
-pub fn pidfd(pid: u32) -> Option<OwnedFd> {
-    // SAFETY: pidfd_open takes a pid and flags and returns a new descriptor or -1.
-    let fd = unsafe { libc::syscall(libc::SYS_pidfd_open, pid as libc::pid_t, 0) };
-    let fd = i32::try_from(fd).ok().filter(|fd| *fd >= 0)?;
-    // SAFETY: the descriptor was just opened and nothing else owns it.
-    Some(unsafe { OwnedFd::from_raw_fd(fd) })
 }
