@@ -27,6 +27,8 @@ struct Row {
     end_apart_m: f64,
     shm_left: usize,
     missed: bool,
+    /// The robot's true travel between the kill and the successor's arrival.
+    moved_m: Option<f64>,
 }
 
 fn chaos(tag: &str, services: &str, kills: usize, seed: u64) -> (Vec<Row>, String) {
@@ -75,6 +77,7 @@ fn rows(csv: &Path, log: &str) -> Vec<Row> {
                 end_apart_m: f[10].parse().expect("end apart"),
                 shm_left: f[11].parse().expect("shm"),
                 missed: f[12] == "true",
+                moved_m: opt(f[13]),
             }
         })
         .collect()
@@ -87,6 +90,10 @@ fn came_back_and_succeeded(rows: &[Row], log: &str) {
         assert_eq!(r.exit_code, Some(0), "{r:?}\n{log}");
         assert!(r.back_ms.is_some_and(|ms| ms < 2_000.0), "{r:?}\n{log}");
         assert_eq!(r.shm_left, 0, "{r:?}");
+        if r.service == "executive" {
+            // No motion without an executive beyond 0.1 m (in lockstep it holds the chain).
+            assert!(r.moved_m.is_some_and(|m| m <= 0.1), "{r:?}");
+        }
     }
 }
 

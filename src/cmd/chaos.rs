@@ -2,7 +2,8 @@
 //! SIGKILLs hit its services, from outside, as a crash would. A run without kills first gives
 //! the reference; each killed run is then judged against it: did the mission reach its goal,
 //! how long was each service gone (kill to its successor on the bus), is the recording
-//! identical, or which messages are missing, and is shared memory clean after the launch.
+//! identical, or which messages are missing, how far the robot truly moved while the service
+//! was gone, and is shared memory clean after the launch.
 //! `chaos/report.rs` tabulates the figures.
 
 mod report;
@@ -164,19 +165,21 @@ fn launch_once(
         let bus = harvey_bus::Bus::join_with_prefix("harvey-chaos", prefix)?;
         let truth = bus.subscriber(harvey_msgs::topics::SIM_TRUTH)?;
         let mut now_ns = 0;
+        let mut pose = None;
         for (at, who) in plan {
             let at_s = *at as f64 * 1e-9;
             while now_ns < *at && child.try_wait()?.is_none() && started.elapsed() < RUN_TIMEOUT {
                 if let Some(t) = truth.latest()? {
                     now_ns = t.header.stamp_ns;
+                    pose = Some(t.world_from_robot);
                 }
                 std::thread::sleep(POLL);
             }
             if child.try_wait()?.is_some() || now_ns < *at {
-                kills.push(Kill { service: who.clone(), at_s, back_ms: None, missed: true });
+                kills.push(Kill { service: who.clone(), at_s, back_ms: None, moved_m: None, missed: true });
                 continue;
             }
-            kills.push(kill_one(prefix, who, at_s));
+            kills.push(kill_one(prefix, who, at_s, &truth, &mut pose));
         }
     }
     let status = loop {
@@ -195,8 +198,14 @@ fn launch_once(
 }
 
 /// SIGKILLs `who` and waits for its successor on the bus (the supervisor's node is its clock
-/// watch, `harvey-supervisor`).
-fn kill_one(prefix: &str, who: &str, at_s: f64) -> Kill {
+/// watch, `harvey-supervisor`); the robot's true travel meanwhile is read from `sim/truth`.
+fn kill_one(
+    prefix: &str,
+    who: &str,
+    at_s: f64,
+    truth: &harvey_bus::Subscriber<harvey_msgs::TruePose>,
+    pose: &mut Option<harvey_msgs::Pose2>,
+) -> Kill {
     let node = if who == SUPERVISOR { "harvey-supervisor" } else { who };
     let find = || {
         harvey_bus::live_nodes(prefix)
@@ -205,19 +214,29 @@ fn kill_one(prefix: &str, who: &str, at_s: f64) -> Kill {
             .find(|n| n.alive && n.name == node)
             .map(|n| n.pid)
     };
-    let mut k = Kill { service: who.to_owned(), at_s, back_ms: None, missed: true };
+    let mut k = Kill { service: who.to_owned(), at_s, back_ms: None, moved_m: None, missed: true };
     let Some(pid) = find() else { return k };
+    if let Some(t) = truth.latest().ok().flatten() {
+        *pose = Some(t.world_from_robot);
+    }
     if kill(Pid::from_raw(pid), Signal::SIGKILL).is_err() {
         return k;
     }
+    let before = *pose;
     k.missed = false;
     let killed = Instant::now();
     while killed.elapsed() < BACK_TIMEOUT {
+        if let Some(t) = truth.latest().ok().flatten() {
+            *pose = Some(t.world_from_robot);
+        }
         if find().is_some_and(|p| p != pid) {
             k.back_ms = Some(killed.elapsed().as_secs_f64() * 1e3);
             break;
         }
         std::thread::sleep(POLL);
+    }
+    if let (Some(a), Some(b)) = (before, *pose) {
+        k.moved_m = Some((b.x_m - a.x_m).hypot(b.y_m - a.y_m));
     }
     k
 }

@@ -16,6 +16,8 @@ pub struct Kill {
     pub at_s: f64,
     /// Kill to the successor on the bus, if it came back.
     pub back_ms: Option<f64>,
+    /// How far the robot truly moved between the kill and the successor's arrival (m).
+    pub moved_m: Option<f64>,
     /// The service was not there to kill (the mission had ended).
     pub missed: bool,
 }
@@ -168,8 +170,8 @@ pub fn table(runs: &[Run], reference: &Run, cpu: &str) -> String {
     services.dedup();
     let mut out = format!(
         "Chaos over {} runs ({} kills) on {cpu}; the reference run took {:.1} s of wall time.\n\n\
-         | killed | kills | missions succeeded | end apart from the reference's, max (m) | back on the bus p50 / p99 (ms) | recordings identical | messages missing / extra | shm files left |\n\
-         |---|---:|---:|---:|---:|---:|---:|---:|\n",
+         | killed | kills | missions succeeded | end apart from the reference's, max (m) | back on the bus p50 / p99 (ms) | robot moved while it was gone, max (m) | recordings identical | messages missing / extra | shm files left |\n\
+         |---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         runs.len(),
         runs.iter().map(|r| r.kills.iter().filter(|k| !k.missed).count()).sum::<usize>(),
         reference.mission_wall.as_secs_f64()
@@ -194,8 +196,13 @@ pub fn table(runs: &[Run], reference: &Run, cpu: &str) -> String {
         let extra: usize = rs.iter().map(|r| r.verdict.extra).sum();
         let apart = rs.iter().filter_map(|r| r.verdict.end_apart_m).fold(0.0, f64::max);
         let shm: usize = rs.iter().map(|r| r.shm_left).sum();
+        let moved = kills
+            .iter()
+            .filter_map(|k| k.moved_m)
+            .fold(None, |m: Option<f64>, x| Some(m.map_or(x, |m| m.max(x))));
+        let moved = moved.map_or("-".to_owned(), |m| format!("{m:.3}"));
         out += &format!(
-            "| {name} | {} | {goal}/{} | {apart:.3} | {lat} | {same}/{} | {missing} / {extra} | {shm} |\n",
+            "| {name} | {} | {goal}/{} | {apart:.3} | {lat} | {moved} | {same}/{} | {missing} / {extra} | {shm} |\n",
             kills.len(),
             rs.len(),
             rs.len()
@@ -211,12 +218,12 @@ pub fn table(runs: &[Run], reference: &Run, cpu: &str) -> String {
 /// One line per kill, for plotting.
 pub fn csv(runs: &[Run]) -> String {
     let mut out = String::from(
-        "run,service,at_s,back_ms,exit_code,identical,missing,missing_span_s,extra,first_difference_s,end_apart_m,shm_left,missed\n",
+        "run,service,at_s,back_ms,exit_code,identical,missing,missing_span_s,extra,first_difference_s,end_apart_m,shm_left,missed,moved_m\n",
     );
     for r in runs {
         for k in &r.kills {
             out += &format!(
-                "{},{},{:.3},{},{},{},{},{:.3},{},{},{},{},{}\n",
+                "{},{},{:.3},{},{},{},{},{:.3},{},{},{},{},{},{}\n",
                 r.dir.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                 k.service,
                 k.at_s,
@@ -229,7 +236,8 @@ pub fn csv(runs: &[Run]) -> String {
                 r.verdict.first_difference_s.map_or(String::new(), |t| format!("{t:.3}")),
                 r.verdict.end_apart_m.map_or(String::new(), |m| format!("{m:.4}")),
                 r.shm_left,
-                k.missed
+                k.missed,
+                k.moved_m.map_or(String::new(), |m| format!("{m:.4}"))
             );
         }
     }
