@@ -1,12 +1,15 @@
 //! The correlation cross-sum `Σ P (T - 128)` for every placement, on each [`Path`]: AVX-512
 //! VNNI (`vpdpbusd`, 64 byte products an instruction), AVX2 (`vpmaddwd` on zero-extended pixel
-//! pairs, exact: no 16-bit saturation), and a portable loop. All are exact integer sums, so they
-//! agree bit for bit; `nc.rs` calls [`cross`].
+//! pairs, exact: no 16-bit saturation), NEON (`smlal`, pixels widened to 16 bits and multiplied
+//! into 32-bit sums), and a portable loop. All are exact integer sums, so they agree bit for
+//! bit; `nc.rs` calls [`cross`].
 //!
 //! Layout (shared with `nc.rs`): `pad` holds the window's rows, `pw` bytes apart, padded with
 //! zeros so whole blocks can be read past the last placement; `out` has a row stride of `nx`
 //! rounded up to [`BLOCK_X`] and `ny` rounded up to [`BLOCK_Y`] rows.
 
+#[cfg(target_arch = "aarch64")]
+use core::arch::aarch64::*;
 #[cfg(target_arch = "x86_64")]
 use core::arch::x86_64::*;
 
@@ -70,6 +73,9 @@ pub(crate) fn cross(path: Path, pad: &[u8], pw: usize, nx: usize, ny: usize, t: 
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
         Path::Avx2 => unsafe { cross_avx2(pad, pw, nx, ny, t, out) },
+        #[cfg(target_arch = "aarch64")]
+        // SAFETY: as above.
+        Path::Neon => unsafe { cross_neon(pad, pw, nx, ny, t, out) },
         _ => cross_portable(pad, pw, nx, ny, t, out),
     }
 }
@@ -159,6 +165,48 @@ unsafe fn cross_avx2(pad: &[u8], pw: usize, nx: usize, ny: usize, t: &Packed, ou
                     let o = out.as_mut_ptr().add((y0 + j) * stride + xb);
                     _mm256_storeu_si256(o as *mut __m256i, a[0]);
                     _mm256_storeu_si256(o.add(8) as *mut __m256i, a[1]);
+                }
+            }
+        }
+    }
+}
+
+/// Blocks of 16 placements (four vectors of 4) x 4 rows. For each template column, 16 image
+/// bytes are loaded once per image row, widened to 16 bits, and `smlal` multiplies them by the
+/// template's value into 32-bit lanes (exact: the product is formed at 32 bits), for every
+/// output row that template row reaches.
+///
+/// # Safety
+/// The CPU must have NEON; sizes as [`cross`] checks them.
+#[cfg(target_arch = "aarch64")]
+#[target_feature(enable = "neon")]
+unsafe fn cross_neon(pad: &[u8], pw: usize, nx: usize, ny: usize, t: &Packed, out: &mut [i32]) {
+    let (stride, npairs, rows, pairs) = (nx.next_multiple_of(BLOCK_X), t.npairs, t.rows, &t.pairs);
+    for y0 in (0..ny).step_by(BLOCK_Y) {
+        for xb in (0..nx).step_by(BLOCK_X) {
+            let mut acc = [[vdupq_n_s32(0); 4]; BLOCK_Y];
+            for yy in 0..rows + 3 {
+                // SAFETY: within `pad` by the size contract (row y0 + yy, bytes xb .. xb + 2 npairs + 16).
+                let base = unsafe { pad.as_ptr().add((y0 + yy) * pw + xb) };
+                for c in 0..2 * npairs {
+                    // SAFETY: as above.
+                    let v = unsafe { vld1q_u8(base.add(c)) };
+                    let lo = vreinterpretq_s16_u16(vmovl_u8(vget_low_u8(v)));
+                    let hi = vreinterpretq_s16_u16(vmovl_high_u8(v));
+                    for (j, a) in acc.iter_mut().enumerate() {
+                        let Some(r) = yy.checked_sub(j).filter(|r| *r < rows) else { continue };
+                        let tv = (pairs[r * npairs + c / 2] >> (16 * (c % 2))) as i16;
+                        a[0] = vmlal_n_s16(a[0], vget_low_s16(lo), tv);
+                        a[1] = vmlal_high_n_s16(a[1], lo, tv);
+                        a[2] = vmlal_n_s16(a[2], vget_low_s16(hi), tv);
+                        a[3] = vmlal_high_n_s16(a[3], hi, tv);
+                    }
+                }
+            }
+            for (j, a) in acc.iter().enumerate() {
+                for (k, v) in a.iter().enumerate() {
+                    // SAFETY: within `out` by the size contract.
+                    unsafe { vst1q_s32(out.as_mut_ptr().add((y0 + j) * stride + xb + 4 * k), *v) };
                 }
             }
         }

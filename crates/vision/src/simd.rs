@@ -1,10 +1,12 @@
 //! Which instruction-set path the kernels run: chosen once per process from what the CPU has,
-//! optionally lowered (never raised) by `HARVEY_SIMD=portable|avx2|avx512` for measurement.
+//! optionally lowered (never raised) by `HARVEY_SIMD=portable|neon|avx2|avx512` for measurement.
 //!
 //! Every hot kernel has one portable body the compiler can vectorise, compiled again for each
 //! path with [`multiversion::target`], plus hand-written intrinsics where the compiler cannot
 //! find the instructions by itself (the correlation cross-sum, Moravec's peak row pass). Each
 //! kernel matches on a [`Path`]; tests run every [`Path::available`] one and compare bit for bit.
+//! On aarch64, NEON is part of the baseline target, so the portable bodies are already NEON
+//! code there; [`Path::Neon`] adds the hand-written NEON cross-sum (`cross.rs`).
 
 use std::fmt;
 use std::sync::OnceLock;
@@ -12,11 +14,14 @@ use std::sync::OnceLock;
 /// The environment variable that lowers the path for measurement.
 pub const ENV: &str = "HARVEY_SIMD";
 
-/// An instruction-set path, slowest first.
+/// An instruction-set path, slowest first (on its own architecture: a path the CPU cannot run
+/// is lowered to the fastest slower one it can, so `avx512` asked of an ARM CPU gives `neon`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Path {
     /// Plain Rust for the build's baseline target.
     Portable,
+    /// aarch64 Advanced SIMD (every aarch64 CPU has it).
+    Neon,
     /// x86-64-v3: AVX2, FMA, BMI2.
     Avx2,
     /// AVX-512 F, BW and VNNI (on top of AVX2).
@@ -25,12 +30,13 @@ pub enum Path {
 
 impl Path {
     /// Every path, slowest first.
-    pub const ALL: [Path; 3] = [Path::Portable, Path::Avx2, Path::Avx512];
+    pub const ALL: [Path; 4] = [Path::Portable, Path::Neon, Path::Avx2, Path::Avx512];
 
     /// The name `HARVEY_SIMD` takes.
     pub fn name(self) -> &'static str {
         match self {
             Path::Portable => "portable",
+            Path::Neon => "neon",
             Path::Avx2 => "avx2",
             Path::Avx512 => "avx512",
         }
@@ -58,7 +64,9 @@ impl Path {
                     && std::is_x86_feature_detected!("avx512bw")
                     && std::is_x86_feature_detected!("avx512vnni")
             }
-            #[cfg(not(target_arch = "x86_64"))]
+            #[cfg(target_arch = "aarch64")]
+            Path::Neon => std::arch::is_aarch64_feature_detected!("neon"),
+            #[allow(unreachable_patterns, reason = "which arms are left depends on the architecture")]
             _ => false,
         }
     }
@@ -83,9 +91,9 @@ impl Path {
         })
     }
 
-    /// `wanted`, or the fastest path the CPU has if that is slower.
+    /// `wanted` if the CPU has it, or else the fastest slower path it has.
     pub fn clamp(wanted: Path) -> Path {
-        wanted.min(Path::best())
+        Path::ALL.into_iter().rev().filter(|p| *p <= wanted).find(|p| p.supported()).unwrap_or(Path::Portable)
     }
 }
 
@@ -128,10 +136,17 @@ mod tests {
             assert_eq!(Path::parse(p.name()), Some(p));
         }
         assert_eq!(Path::parse("AVX2"), Some(Path::Avx2));
-        assert_eq!(Path::parse("neon"), None);
+        assert_eq!(Path::parse("neon"), Some(Path::Neon));
+        assert_eq!(Path::parse("sse2"), None);
         assert!(Path::active().supported());
         assert!(Path::clamp(Path::Avx512).supported());
         assert_eq!(Path::clamp(Path::Portable), Path::Portable);
         assert_eq!(Path::available().first(), Some(&Path::Portable));
+        // A path of the other architecture is never chosen.
+        assert!(Path::clamp(Path::Neon).supported());
+        #[cfg(target_arch = "x86_64")]
+        assert_eq!(Path::clamp(Path::Neon), Path::Portable);
+        #[cfg(target_arch = "aarch64")]
+        assert_eq!(Path::clamp(Path::Avx512), Path::Neon);
     }
 }

@@ -138,3 +138,14 @@ impl ClampTo for Rect {
         Rect::new(self.x0 + dx, self.y0 + dy, self.x1 + dx, self.y1 + dy)
     }
 }
+
+#[test]
+fn neon_is_the_path_an_aarch64_cpu_takes() {
+    // Every aarch64 CPU has NEON, so the comparisons above run it against the portable path.
+    if cfg!(target_arch = "aarch64") {
+        assert!(Path::available().contains(&Path::Neon));
+        assert_eq!(Path::best(), Path::Neon);
+    } else {
+        assert!(!Path::available().contains(&Path::Neon));
+    }
+}
