@@ -9,6 +9,7 @@ pub mod flf;
 pub mod frs;
 pub mod hough;
 pub mod image;
+pub mod levels;
 pub mod moravec;
 pub mod nc;
 pub mod noise;

@@ -52,6 +52,7 @@ const POSITIVE: &[&str] = &[
     "sweep_deg",
     "centred_deg",
     "wander_s",
+    "ring_contrast",
     "near_m",
     "park_m",
     "lost_m",

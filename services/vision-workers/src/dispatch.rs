@@ -215,8 +215,17 @@ impl Dispatcher {
             }
             VisionAlgorithm::Poles => {
                 let field = self.world.poles.as_ref().ok_or(VisionStatus::BadParameter)?;
-                let (lo, area) = (param(req, 0, 200.0), param(req, 1, 3.0));
-                if !(1.0..=255.0).contains(&lo) || area < 1.0 {
+                // A grey level given (params[0]) is used as it is; else the threshold follows the
+                // window's brightness, `contrast` (params[2]) times its bright background.
+                let (area, contrast) = (param(req, 1, 3.0), param(req, 2, crate::poles::RING_CONTRAST));
+                if !(1.0..=4.0).contains(&contrast) || area < 1.0 {
+                    return Err(VisionStatus::BadParameter);
+                }
+                let lo = match req.params[0] {
+                    0.0 => f32::from(crate::poles::ring_threshold(&img, window, contrast)),
+                    lo => lo,
+                };
+                if !(1.0..=255.0).contains(&lo) {
                     return Err(VisionStatus::BadParameter);
                 }
                 let ranges = [ClassRange { lo: lo as u8, hi: 255, class: 1 }];

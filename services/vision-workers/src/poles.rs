@@ -4,7 +4,31 @@
 //! read from where it sits between the other two (a ratio: no calibration of the range needed).
 
 use harvey_vision::frs::Region;
+use harvey_vision::levels::{histogram, percentile};
+use harvey_vision::noise::noise_sigma;
+use harvey_vision::{Gray, Rect};
 use harvey_world::PoleField;
+
+/// The contrast a request that names none gets (the poles mission sends its own,
+/// `[mission.poles] ring_contrast`).
+pub const RING_CONTRAST: f32 = 1.4;
+
+/// The window's "bright background": its 90th percentile (ring tape never covers a tenth of a
+/// window; walls, floor and pole bodies do).
+const BACKGROUND_QUANTILE: f32 = 0.9;
+/// A ring's threshold stands at least this many noise sigmas above the bright background, so
+/// that noise alone (a pixel passes with odds of about 3 in 10 million) never makes a ring.
+const NOISE_SIGMAS: f32 = 5.0;
+
+/// The grey level from which a pixel of `w` counts as ring tape: `contrast` times the window's
+/// bright background, and at least [`NOISE_SIGMAS`] of its own noise above it (004 §5.1.1's
+/// tape is retro-reflective, brighter than anything else in view, whatever the illumination; a
+/// fixed grey level misses it under a dim light or towards a vignetted corner). At most 255.
+pub fn ring_threshold(img: &Gray<'_>, w: Rect, contrast: f32) -> u8 {
+    let background = f32::from(percentile(&histogram(img, w), BACKGROUND_QUANTILE));
+    let floor = background + NOISE_SIGMAS * noise_sigma(img, w);
+    (contrast * background).max(floor).ceil().clamp(1.0, 255.0) as u8
+}
 
 /// The poles among `rings` (bright regions) of an image `image_width` wide, each `[u, range_m,
 /// code, v_top, v_bottom, 0]`. A column of other than three rings, whose middle ring is no code,
@@ -48,4 +72,32 @@ pub fn group<'a>(
         let range = focal_px * (f.top_m - f.bottom_m) / span;
         Some([seed.centroid[0], range as f32, code as f32, top as f32, bottom as f32, 0.0])
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use harvey_vision::GrayBuf;
+
+    /// Walls at `wall`, three rings of tape at `tape` in a column, and a hashed noise of +-`n`.
+    fn scene(wall: u8, tape: u8, n: u8) -> GrayBuf {
+        GrayBuf::from_fn(120, 90, |x, y| {
+            let ring = (50..58).contains(&x) && [20, 40, 70].iter().any(|r| (*r..r + 3).contains(&y));
+            let z = ((x * 7919 + y * 104_729) % 251) as i32 % (2 * i32::from(n) + 1) - i32::from(n);
+            (i32::from(if ring { tape } else { wall }) + z).clamp(0, 255) as u8
+        })
+    }
+
+    #[test]
+    fn the_threshold_follows_the_light_and_sits_between_walls_and_tape() {
+        for (wall, tape) in [(110, 220), (85, 170), (60, 120)] {
+            let img = scene(wall, tape, 4);
+            let t = ring_threshold(&img.view(), img.view().full(), 1.4);
+            assert!(t > wall + 4 && t < tape - 4, "wall {wall}, tape {tape}: threshold {t}");
+        }
+        // With no tape in view the threshold stays above every wall pixel.
+        let img = scene(100, 100, 4);
+        let t = ring_threshold(&img.view(), img.view().full(), 1.4);
+        assert!(t > 104, "{t}");
+    }
 }

@@ -193,7 +193,9 @@ impl PoleHunt {
                 Look::Backing { until_ns } if now >= until_ns => self.look = Look::Ask,
                 Look::Backing { .. } => spin = Some(0.0),
                 Look::Ask => {
-                    request = Some(self.seq.request(now, VisionAlgorithm::Poles, [0.0; 4], [0.0; 8]));
+                    // The whole frame; params: no fixed grey level, the default area, the contrast.
+                    let params = [0.0, 0.0, self.g.ring_contrast as f32, 0.0, 0.0, 0.0, 0.0, 0.0];
+                    request = Some(self.seq.request(now, VisionAlgorithm::Poles, [0.0; 4], params));
                     self.look = Look::Waiting;
                 }
                 Look::Waiting => {}

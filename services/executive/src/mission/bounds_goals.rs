@@ -15,6 +15,8 @@ const HEIGHT: Range = Range::closed(0.0, 100.0, "m");
 const GREY: Range = Range::closed(0.0, 255.0, "");
 /// Fractions (a certainty, a decay per tick).
 const FRACTION: Range = Range::closed(0.0, 1.0, "");
+/// How many times its background ring tape must be (the vision workers refuse beyond 1..=4).
+const RING_CONTRAST: Range = Range::closed(1.0, 4.0, "");
 /// An area in the image: positive, up to the largest image the world's camera renders
 /// (4096 x 4096 px).
 const AREA_PX: Range = Range::above(0.0, 16_777_216.0, "px");
@@ -91,6 +93,7 @@ pub(crate) fn check_poles(k: &KeyPath, p: &PolesGoal) -> Result<(), OutOfRange> 
     check(&k.key("sweep_deg"), p.sweep_deg, &SWEEP)?;
     check(&k.key("centred_deg"), p.centred_deg, &HALF_TURN)?;
     check(&k.key("wander_s"), p.wander_s, &TIMEOUT)?;
+    check(&k.key("ring_contrast"), p.ring_contrast, &RING_CONTRAST)?;
     check(&k.key("near_m"), p.near_m, &LENGTH)?;
     check(&k.key("timer_slack_s"), p.timer_slack_s, &WAIT)?;
     check(&k.key("beacon_wait_s"), p.beacon_wait_s, &WAIT)?;

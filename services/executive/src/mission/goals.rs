@@ -114,6 +114,9 @@ pub struct PolesGoal {
     pub sweep_deg: f64,
     pub centred_deg: f64,
     pub wander_s: f64,
+    /// Pole recognition: a pixel is ring tape from this many times the frame's bright
+    /// background (the vision workers' adaptive threshold, `poles.rs`).
+    pub ring_contrast: f64,
     /// q2: ballistic motion ends this near the pole (believed), or when the timer runs out:
     /// `timer_slack_s` beyond the time the distance takes at the top speed.
     pub near_m: f64,
