@@ -1,9 +1,9 @@
 //! How the executive's own working is drawn: each action-level correction as plots (heading
-//! error, turn, estimated offset from the line) and a log line; each pose refinement as the
-//! expected and refined poses in the world view and a log line; the plan sketch as a path
-//! through its milestones (solid where primitive, faint where still abstract), with each
-//! milestone check in the log; a sequenced behaviour's acceptor state as a plot (and each
-//! transition in the log) and its motor schemas' vectors as arrows from the robot.
+//! error and turn in degrees, estimated offset from the line in metres) and a log line; each pose
+//! refinement as the expected and refined poses in the world view and a log line; the plan sketch
+//! as a path through its numbered milestones (solid where primitive, faint where still abstract),
+//! its stage as a state lane and each milestone check in the log; a sequenced behaviour's acceptor
+//! state as a state lane (each transition in the log) and its motor schemas' vectors as arrows.
 
 use harvey_msgs::{BehaviourState, CheckOutcome, PlanSketch, PoseFix, ServoCorrection};
 
@@ -13,9 +13,9 @@ impl RrdWriter {
     pub fn servo(&mut self, c: &ServoCorrection) -> Result<(), RrdError> {
         self.at(c.header.stamp_ns);
         for (path, v) in [
-            ("plots/servo_heading_error_deg", c.heading_error_rad.to_degrees()),
-            ("plots/servo_correction_deg", c.correction_rad.to_degrees()),
-            ("plots/servo_offset_estimate_m", c.offset_m),
+            ("plots/servo/heading_error_deg", c.heading_error_rad.to_degrees()),
+            ("plots/servo/correction_deg", c.correction_rad.to_degrees()),
+            ("plots/deviation/estimated_m", c.offset_m),
         ] {
             self.rec.log(path, &rerun::Scalars::single(v)).map_err(|e| self.err(e))?;
         }
@@ -28,9 +28,7 @@ impl RrdWriter {
             c.heading_error_rad.to_degrees(),
             c.correction_rad.to_degrees()
         );
-        self.rec
-            .log("log", &rerun::TextLog::new(text).with_level(rerun::TextLogLevel::INFO))
-            .map_err(|e| self.err(e))
+        self.say("executive", rerun::TextLogLevel::INFO, text)
     }
 
     pub fn pose_fix(&mut self, p: &PoseFix) -> Result<(), RrdError> {
@@ -51,9 +49,7 @@ impl RrdWriter {
             p.kept,
             p.rms_px
         );
-        self.rec
-            .log("log", &rerun::TextLog::new(text).with_level(rerun::TextLogLevel::INFO))
-            .map_err(|e| self.err(e))
+        self.say("executive", rerun::TextLogLevel::INFO, text)
     }
 
     pub fn plan(&mut self, p: &PlanSketch) -> Result<(), RrdError> {
@@ -76,12 +72,15 @@ impl RrdWriter {
                 .map_err(|e| self.err(e))?;
         }
         let milestones = rerun::Points2D::new(places.iter().skip(1).copied())
+            .with_labels((1..n).map(|k| format!("m{k}")))
             .with_radii([0.06])
             .with_colors([rerun::Color::from_rgb(60, 200, 120)]);
         self.rec.log("world/plan/milestones", &milestones).map_err(|e| self.err(e))?;
-        self.rec
-            .log("plots/plan_stage", &rerun::Scalars::single(f64::from(p.stage)))
-            .map_err(|e| self.err(e))?;
+        self.plan_places = (0..n).map(|k| [p.places_m[2 * k], p.places_m[2 * k + 1]]).collect();
+        if self.plan_stage != Some(p.stage) {
+            self.plan_stage = Some(p.stage);
+            self.lane("plan", format!("stage {}", p.stage))?;
+        }
         if p.checks == self.plan_checks || p.last_outcome == 0 {
             return Ok(());
         }
@@ -97,14 +96,15 @@ impl RrdWriter {
             "milestone check {}: {what}, {:.3} m off ({} replans)",
             p.checks, p.last_off_m, p.replans
         );
-        self.rec.log("log", &rerun::TextLog::new(text).with_level(level)).map_err(|e| self.err(e))
+        self.say("executive", level, text)
     }
 
     pub fn behaviour(&mut self, b: &BehaviourState) -> Result<(), RrdError> {
         self.at(b.header.stamp_ns);
-        self.rec
-            .log("plots/fsa_state", &rerun::Scalars::single(f64::from(b.fsa_state)))
-            .map_err(|e| self.err(e))?;
+        if self.fsa_state != Some(b.fsa_state) {
+            self.fsa_state = Some(b.fsa_state);
+            self.lane("acceptor", format!("q{}", b.fsa_state))?;
+        }
         // move-to-goal, avoid-static-obstacle, noise, avoid-past, probe, sum; 1 m per 0.1 m/s.
         let colours =
             [(40, 200, 80), (230, 60, 50), (160, 160, 160), (200, 120, 220), (80, 170, 230), (255, 255, 255)];
@@ -119,7 +119,7 @@ impl RrdWriter {
             }
         }
         let arrows = rerun::Arrows2D::from_vectors(vectors).with_origins(origins).with_colors(cols);
-        self.rec.log("world/schemas", &arrows).map_err(|e| self.err(e))?;
+        self.rec.log("world/robot/schemas", &arrows).map_err(|e| self.err(e))?;
         if b.transitions == self.fsa_transitions {
             return Ok(());
         }
@@ -127,9 +127,7 @@ impl RrdWriter {
         let trigger = ["normal", "terminal", "recoverable error", "fatal error"]
             .get(b.last_trigger as usize)
             .unwrap_or(&"?");
-        let text = format!("acceptor: {trigger} -> q{} (transition {})", b.fsa_state, b.transitions);
-        self.rec
-            .log("log", &rerun::TextLog::new(text).with_level(rerun::TextLogLevel::INFO))
-            .map_err(|e| self.err(e))
+        let text = format!("{trigger} -> q{} (transition {})", b.fsa_state, b.transitions);
+        self.say("acceptor", rerun::TextLogLevel::INFO, text)
     }
 }

@@ -1,30 +1,40 @@
-//! How vision results are drawn on the camera image: lines, corners, region centroids and
-//! correlation matches, one entity per request; failed requests go to the log.
+//! How vision results are drawn on the camera image: lines, corners, region centroids, the dock,
+//! poles and correlation matches (a line from where the vertex was expected to where it was
+//! found), one entity per request, taken off once stale; labels only where a result has a few
+//! items; the light blob's size as a plot; failed requests go to the log.
 
 use harvey_msgs::{VisionAlgorithm, VisionResult, VisionStatus};
 
 use super::{RrdError, RrdWriter};
 
+/// The items of one result that carry a label.
+const LABELLED: usize = 3;
+
 impl RrdWriter {
     pub fn vision_result(&mut self, r: &VisionResult) -> Result<(), RrdError> {
         self.at(r.header.stamp_ns);
         let path = format!("camera/image/vision/{}", r.request_id);
+        self.results.insert(r.request_id, r.header.stamp_ns);
         let items = &r.items[..(r.count as usize).min(r.items.len())];
         let status = VisionStatus::from_raw(r.status);
         if status != Some(VisionStatus::Found) {
             self.rec.log(path.as_str(), &rerun::Clear::flat()).map_err(|e| self.err(e))?;
             if status != Some(VisionStatus::NotFound) {
-                let text =
-                    format!("vision request {} failed on frame {}: {:?}", r.request_id, r.frame_seq, status);
-                let log = rerun::TextLog::new(text).with_level(rerun::TextLogLevel::WARN);
-                self.rec.log("log", &log).map_err(|e| self.err(e))?;
+                let text = format!("request {} failed on frame {}: {:?}", r.request_id, r.frame_seq, status);
+                self.say("vision", rerun::TextLogLevel::WARN, text)?;
             }
             return Ok(());
         }
-        let colour = rerun::Color::from_rgb(255, 200, 0);
+        let colour = super::colour::RESULT;
+        // Labels on the first few items only (strongest, longest or largest first): more would
+        // cover the image and each other.
         let points = |f: &dyn Fn(&[f32; 6]) -> String| {
             let pts: Vec<[f32; 2]> = items.iter().map(|i| [i.values[0], i.values[1]]).collect();
-            let labels: Vec<String> = items.iter().map(|i| f(&i.values)).collect();
+            let labels: Vec<String> = items
+                .iter()
+                .enumerate()
+                .map(|(k, i)| if k < LABELLED { f(&i.values) } else { String::new() })
+                .collect();
             rerun::Points2D::new(pts).with_labels(labels).with_radii([2.5]).with_colors([colour])
         };
         let logged = match VisionAlgorithm::from_raw(r.algorithm) {
@@ -36,13 +46,22 @@ impl RrdWriter {
                 self.rec.log(path.as_str(), &rerun::LineStrips2D::new(strips).with_colors([colour]))
             }
             Some(VisionAlgorithm::Moravec) => {
-                self.rec.log(path.as_str(), &points(&|v| format!("{:.0}", v[2])))
+                let pts: Vec<[f32; 2]> = items.iter().map(|i| [i.values[0], i.values[1]]).collect();
+                self.rec
+                    .log(path.as_str(), &rerun::Points2D::new(pts).with_radii([2.0]).with_colors([colour]))
             }
             Some(VisionAlgorithm::RegionSegmenter) => {
                 self.rec.log(path.as_str(), &points(&|v| format!("{:.0} px, mean {:.0}", v[2], v[3])))
             }
             Some(VisionAlgorithm::Phototropic) => {
-                self.rec.log(path.as_str(), &points(&|v| format!("light {:.0} px", v[2])))
+                // The blob's size goes to a plot: a label here would sit on the other results'.
+                if let Some(i) = items.first() {
+                    let size = rerun::Scalars::single(f64::from(i.values[2]));
+                    self.rec.log("plots/vision/light_px", &size).map_err(|e| self.err(e))?;
+                }
+                let pts: Vec<[f32; 2]> = items.iter().map(|i| [i.values[0], i.values[1]]).collect();
+                self.rec
+                    .log(path.as_str(), &rerun::Points2D::new(pts).with_radii([4.0]).with_colors([colour]))
             }
             Some(VisionAlgorithm::Activity) => {
                 self.rec.log(path.as_str(), &points(&|v| format!("activity {:.1}", v[2])))
@@ -72,7 +91,11 @@ impl RrdWriter {
                 )
             }
             Some(VisionAlgorithm::Correlate) => {
-                self.rec.log(path.as_str(), &points(&|v| format!("NC {:.3}", v[2])))
+                let moves: Vec<Vec<[f32; 2]>> = items
+                    .iter()
+                    .map(|i| vec![[i.values[3], i.values[4]], [i.values[0], i.values[1]]])
+                    .collect();
+                self.rec.log(path.as_str(), &rerun::LineStrips2D::new(moves).with_colors([colour]))
             }
             None => return Ok(()),
         };

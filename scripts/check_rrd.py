@@ -1,0 +1,64 @@
+#!/usr/bin/env python3
+"""Checks a Harvey Rerun recording with Rerun 0.36.3's own reader (rerun-sdk).
+
+usage: check_rrd.py RUN.rrd [--same-as OTHER.rrd] [--need ENTITY]...
+
+- every entity the view is built on is there (the camera image, the world view round the robot
+  and the whole world, the paths, one plot subtree per quantity, the log and the state lanes),
+  and each --need entity too;
+- the log is a log, not a per-tick stream: over 100 ticks or more, its lines are fewer than a
+  tenth of the true poses;
+- with --same-as, both files draw the same entities, but for the loop latency (wall clock, drawn
+  only by the live recorder): `harvey export` draws what the recorder drew live.
+"""
+import argparse
+import sys
+from collections import Counter
+
+import rerun as rr
+
+ALWAYS = [
+    "/camera/image", "/world/map/walls", "/world/near/walls", "/world/near/frame", "/world/paths/truth",
+    "/world/paths/estimated", "/world/robot/truth", "/world/near/uncertainty", "/world/map/uncertainty", "/plots/uncertainty/area_m2",
+    "/plots/heading/wedge_deg", "/log/executive", "/states/mission", "/states/ums",
+]
+LIVE_ONLY = {"/plots/latency/loop_ms"}
+
+
+def rows(path):
+    """Rows per entity path in the recording (not the blueprint)."""
+    counts = Counter()
+    for chunk in rr.experimental.RrdReader(path).stream().to_chunks():
+        counts[str(chunk.entity_path)] += chunk.num_rows
+    return counts
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("rrd")
+    ap.add_argument("--same-as")
+    ap.add_argument("--need", action="append", default=[])
+    a = ap.parse_args()
+    counts = rows(a.rrd)
+    problems = [f"{a.rrd}: no entity {e}" for e in ALWAYS + a.need if counts[e] == 0]
+    log_lines = sum(n for e, n in counts.items() if e.startswith("/log/"))
+    truths = counts["/world/robot/truth"]
+    if truths >= 100 and log_lines * 10 >= truths:
+        problems.append(f"{a.rrd}: {log_lines} log lines for {truths} true poses: the log repeats per tick")
+    if a.same_as:
+        other = rows(a.same_as)
+        mine = {e for e in counts if not e.startswith("/__")} - LIVE_ONLY
+        theirs = {e for e in other if not e.startswith("/__")} - LIVE_ONLY
+        for e in sorted(mine ^ theirs):
+            where = a.rrd if e in mine else a.same_as
+            problems.append(f"{e} is drawn only in {where}")
+    for p in problems:
+        print(p, file=sys.stderr)
+    if problems:
+        sys.exit(1)
+    print(f"{a.rrd}: {len(counts)} entities, {log_lines} log lines for {truths} true poses"
+          + (f", the same entities as {a.same_as}" if a.same_as else ""))
+
+
+if __name__ == "__main__":
+    main()
