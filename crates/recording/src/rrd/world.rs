@@ -69,9 +69,7 @@ impl RrdWriter {
         self.truth_pose = Some([p.x_m, p.y_m, p.heading_rad]);
         self.rec.log("world/robot/truth", &pose_arrow(&p, colour::TRUTH)).map_err(|e| self.err(e))?;
         if self.truth_trail.push([p.x_m, p.y_m]) {
-            let line =
-                rerun::LineStrips2D::new([strip(&self.truth_trail.points)]).with_colors([colour::TRUTH]);
-            self.rec.log("world/paths/truth", &line).map_err(|e| self.err(e))?;
+            self.path_line("world/paths/truth", &self.truth_trail.points, colour::TRUTH)?;
         }
         self.frame_the_action()?;
         // Servo deviation: how far the true robot is off the line it is driving, the line
@@ -87,9 +85,7 @@ impl RrdWriter {
         self.pose = Some([p.x_m, p.y_m, p.heading_rad]);
         self.rec.log("world/robot/odometry", &pose_arrow(&p, colour::ODOMETRY)).map_err(|e| self.err(e))?;
         if self.odometry_trail.push([p.x_m, p.y_m]) {
-            let line = rerun::LineStrips2D::new([strip(&self.odometry_trail.points)])
-                .with_colors([colour::ODOMETRY]);
-            self.rec.log("world/paths/odometry", &line).map_err(|e| self.err(e))?;
+            self.path_line("world/paths/odometry", &self.odometry_trail.points, colour::ODOMETRY)?;
         }
         Ok(())
     }
@@ -99,9 +95,13 @@ impl RrdWriter {
         if !self.estimate_trail.push([p.x_m, p.y_m]) {
             return Ok(());
         }
-        let line =
-            rerun::LineStrips2D::new([strip(&self.estimate_trail.points)]).with_colors([colour::ESTIMATE]);
-        self.rec.log("world/paths/estimated", &line).map_err(|e| self.err(e))
+        self.path_line("world/paths/estimated", &self.estimate_trail.points, colour::ESTIMATE)
+    }
+
+    /// A trail's points drawn as one line.
+    fn path_line(&self, path: &str, points: &[[f64; 2]], tint: rerun::Color) -> Result<(), RrdError> {
+        let line = rerun::LineStrips2D::new([strip(points)]).with_colors([tint]);
+        self.rec.log(path, &line).map_err(|e| self.err(e))
     }
 
     /// Redraws the view round the robot when the box round the action has moved or the set of
@@ -203,7 +203,7 @@ impl RrdWriter {
         self.rec.log("world/map/uncertainty", &polygon).map_err(|e| self.err(e))?;
         // Round the robot, a lost robot's polygon (hundreds of metres wide) is cut at the box
         // instead of taking the view over.
-        let corners: Vec<[f64; 2]> = m.vertices_m[..n].to_vec();
+        let corners = &m.vertices_m[..n];
         let edges: Vec<Vec<[f32; 2]>> = match self.frame {
             None => vec![ring(1.0)],
             Some(f) => (0..n)
