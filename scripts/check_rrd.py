@@ -1,13 +1,15 @@
 #!/usr/bin/env python3
 """Checks a Harvey Rerun recording with Rerun 0.36.3's own reader (rerun-sdk).
 
-usage: check_rrd.py RUN.rrd [--same-as OTHER.rrd] [--need ENTITY]...
+usage: check_rrd.py RUN.rrd [--same-as OTHER.rrd] [--need ENTITY]... [--say ENTITY=TEXT]...
 
 - every entity the view is built on is there (the camera image, the world view round the robot
   and the whole world, the paths, one plot subtree per quantity, the log and the state lanes),
   and each --need entity too;
 - the log is a log, not a per-tick stream: over 100 ticks or more, its lines are fewer than a
   tenth of the true poses;
+- each --say: a line of the log entity ENTITY contains TEXT, at level WARN or ERROR (a service's
+  own warning brought in from `rosout`);
 - with --same-as, both files draw the same entities, but for the loop latency (wall clock, drawn
   only by the live recorder): `harvey export` draws what the recorder drew live.
 """
@@ -33,11 +35,31 @@ def rows(path):
     return counts
 
 
+def warnings(path):
+    """(entity, level, text) of every WARN or ERROR line of the log."""
+    out = []
+    for chunk in rr.experimental.RrdReader(path).stream().to_chunks():
+        entity = str(chunk.entity_path)
+        if not entity.startswith("/log/"):
+            continue
+        batch = chunk.to_record_batch()
+        if "TextLog:text" not in batch.schema.names or "TextLog:level" not in batch.schema.names:
+            continue
+        texts = batch.column("TextLog:text").to_pylist()
+        levels = batch.column("TextLog:level").to_pylist()
+        for text, level in zip(texts, levels):
+            for t, l in zip(text or [], level or []):
+                if l in ("WARN", "ERROR"):
+                    out.append((entity, l, t))
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("rrd")
     ap.add_argument("--same-as")
     ap.add_argument("--need", action="append", default=[])
+    ap.add_argument("--say", action="append", default=[])
     a = ap.parse_args()
     counts = rows(a.rrd)
     problems = [f"{a.rrd}: no entity {e}" for e in ALWAYS + a.need if counts[e] == 0]
@@ -45,6 +67,11 @@ def main():
     truths = counts["/world/robot/truth"]
     if truths >= 100 and log_lines * 10 >= truths:
         problems.append(f"{a.rrd}: {log_lines} log lines for {truths} true poses: the log repeats per tick")
+    said = warnings(a.rrd) if a.say else []
+    for want in a.say:
+        entity, _, text = want.partition("=")
+        if not any(e == entity and text in t for e, _, t in said):
+            problems.append(f"{a.rrd}: no WARN or ERROR line of {entity} says {text!r}")
     if a.same_as:
         other = rows(a.same_as)
         mine = {e for e in counts if not e.startswith("/__")} - LIVE_ONLY

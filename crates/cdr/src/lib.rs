@@ -3,6 +3,7 @@
 //! read Harvey's recordings without Harvey's code. Decoding serves replay and `harvey info`.
 
 mod codec;
+mod log;
 mod schema;
 mod types;
 

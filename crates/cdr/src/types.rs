@@ -17,7 +17,8 @@ pub trait Ros2Msg: Cdr {
     const DEF: &'static Def;
 }
 
-static TIME: Def = Def { name: "builtin_interfaces/Time", text: "int32 sec\nuint32 nanosec\n", deps: &[] };
+pub(crate) static TIME: Def =
+    Def { name: "builtin_interfaces/Time", text: "int32 sec\nuint32 nanosec\n", deps: &[] };
 static STD_HEADER: Def =
     Def { name: "std_msgs/Header", text: "builtin_interfaces/Time stamp\nstring frame_id\n", deps: &[&TIME] };
 static MOTION_COMMAND: Def = Def {

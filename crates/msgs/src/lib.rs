@@ -7,6 +7,7 @@
 
 mod executive;
 mod frame;
+mod log;
 mod payloads;
 pub mod topics;
 mod vision;
@@ -15,6 +16,7 @@ pub use executive::*;
 pub use frame::{Encoding, FrameHeader};
 pub use iceoryx2_bb_derive_macros::ZeroCopySend;
 pub use iceoryx2_bb_elementary_traits::zero_copy_send::ZeroCopySend;
+pub use log::{LOG_NAME_BYTES, LOG_TEXT_BYTES, LogLevel, LogLine};
 pub use payloads::*;
 pub use topics::{FrameTopic, Qos, Topic};
 pub use vision::*;

@@ -3,9 +3,9 @@
 use core::marker::PhantomData;
 
 use crate::{
-    BehaviourState, Detections, EncodersRaw, Expectation, LandmarkSighting, MissionStatus, MotionCommand,
-    Odometry, PlanSketch, PoseFix, Progress, ServoCorrection, SonarRaw, SonarRing, TruePose, UncertaintyMap,
-    VisionRequest, VisionResult,
+    BehaviourState, Detections, EncodersRaw, Expectation, LandmarkSighting, LogLine, MissionStatus,
+    MotionCommand, Odometry, PlanSketch, PoseFix, Progress, ServoCorrection, SonarRaw, SonarRing, TruePose,
+    UncertaintyMap, VisionRequest, VisionResult,
 };
 
 /// Queue sizing of a topic. Every process opening the topic uses the same numbers, so the
@@ -34,6 +34,8 @@ impl Qos {
     /// rgb8, 3.4 MB at 640x480 mono8). The history frame is what a restarted consumer is
     /// handed again (the supervisor's re-offer, `harvey_bus` `reoffer.rs`).
     pub const FRAMES: Qos = Qos { buffer: 2, borrowed: 1, history: 1, max_publishers: 1, max_subscribers: 3 };
+    /// Services' log lines (`rosout`): every service publishes on it, as ROS 2 nodes do.
+    pub const LOG: Qos = Qos { buffer: 16, borrowed: 2, history: 16, max_publishers: 16, max_subscribers: 8 };
     /// A clock party's progress: read by its successor, the clock master and the supervisor
     /// (which also publishes, to start the chain and to resume it after a restart).
     pub const CLOCK: Qos = Qos { buffer: 8, borrowed: 1, history: 0, max_publishers: 2, max_subscribers: 4 };
@@ -86,6 +88,9 @@ pub const EXECUTIVE_PLAN: Topic<PlanSketch> = Topic::new("executive/plan", Qos::
 pub const EXECUTIVE_BEHAVIOUR: Topic<BehaviourState> = Topic::new("executive/behaviour", Qos::STATE);
 pub const VISION_REQUESTS: Topic<VisionRequest> = Topic::new("vision/requests", Qos::STATE);
 pub const VISION_RESULTS: Topic<VisionResult> = Topic::new("vision/results", Qos::STATE);
+/// Every service's warnings and errors, stamped with the tick that raised them (ROS 2's
+/// `/rosout`, `rcl_interfaces/msg/Log` in a recording).
+pub const ROSOUT: Topic<LogLine> = Topic::new("rosout", Qos::LOG);
 pub const CAMERA_FRAME: FrameTopic = FrameTopic { name: "camera/frame", qos: Qos::FRAMES };
 
 /// The progress topic of clock party `party` (deterministic mode), `clock/<party>`: bus
@@ -116,6 +121,7 @@ pub const ALL: &[&str] = &[
     EXECUTIVE_BEHAVIOUR.name,
     VISION_REQUESTS.name,
     VISION_RESULTS.name,
+    ROSOUT.name,
     CAMERA_FRAME.name,
 ];
 

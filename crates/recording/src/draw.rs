@@ -51,6 +51,7 @@ draw_with!(
     harvey_msgs::BehaviourState => behaviour,
     Detections => detections,
     VisionResult => vision_result,
+    harvey_msgs::LogLine => rosout,
 );
 
 /// Requests are in the MCAP file; the view shows their results.
@@ -101,6 +102,7 @@ pub fn draw_recorded(w: &mut RrdWriter, topic: &str, data: &[u8]) -> Result<bool
         _ if t == topics::EXECUTIVE_BEHAVIOUR.name => draw::<harvey_msgs::BehaviourState>(w, data)?,
         _ if t == topics::VISION_REQUESTS.name => draw::<VisionRequest>(w, data)?,
         _ if t == topics::VISION_RESULTS.name => draw::<VisionResult>(w, data)?,
+        _ if t == topics::ROSOUT.name => draw::<harvey_msgs::LogLine>(w, data)?,
         _ if t == topics::CAMERA_FRAME.name => {
             let (h, pixels) = decode_image(data)?;
             w.frame(&h, pixels)?;

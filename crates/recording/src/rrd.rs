@@ -107,6 +107,8 @@ pub struct RrdWriter {
     last_command: Option<String>,
     last_reflex: Option<String>,
     lost: Option<bool>,
+    /// The services' `rosout` lines drawn lately, so a repeated one is drawn once a while.
+    repeats: log::Repeats,
 }
 
 /// Paths keep a point every 5 cm, a few thousand at most.
@@ -149,6 +151,7 @@ impl RrdWriter {
             last_command: None,
             last_reflex: None,
             lost: None,
+            repeats: log::Repeats::default(),
         };
         w.name_the_plots()?;
         w.draw_world()?;

@@ -2,13 +2,14 @@
 //! recording splits into ticks of them (what `harvey-replayer` feeds a replay).
 //!
 //! A run's inputs are what came from outside the software under test: the simulator's truth,
-//! the DRV's raw reports and the camera's frames. `harvey replay` runs every other service again
+//! the DRV's raw reports, the camera's frames, and the bridge's own warnings on `rosout` (it is
+//! replaced too, so its lines are replayed, not produced again). `harvey replay` runs every other service again
 //! and this replayer, as clock master, hands them the recorded inputs one tick at a time, just as
 //! the bridge did live. In deterministic mode every party saw each tick's inputs at its turn, so
 //! the services publish again exactly what they published then.
 
 use harvey_cdr::{CdrError, decode, decode_image};
-use harvey_msgs::{EncodersRaw, FrameHeader, SonarRaw, TruePose, topics};
+use harvey_msgs::{EncodersRaw, FrameHeader, LogLine, SonarRaw, TruePose, topics};
 
 use crate::{Message, Recording, RecordingError};
 
@@ -23,13 +24,32 @@ pub const INPUT_TOPICS: [&str; 4] = [
 /// Services that produced the inputs live, left out of a replay (by executable name).
 pub const INPUT_SERVICES: [&str; 3] = ["harvey-sim-drv", "harvey-denning-bridge", "harvey-camera"];
 
+/// The `rosout` names of those services that log there: their lines are inputs of a replay.
+pub const INPUT_LOG_NAMES: [&str; 1] = ["denning-bridge"];
+
 /// One recorded input, decoded.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Input<'a> {
     Truth(TruePose),
     Sonar(SonarRaw),
     Encoders(EncodersRaw),
-    Frame { header: FrameHeader, pixels: &'a [u8] },
+    Frame {
+        header: FrameHeader,
+        pixels: &'a [u8],
+    },
+    /// A replaced service's warning; `seq` restored from the MCAP `sequence`.
+    Log(Box<LogLine>),
+}
+
+/// Whether a recorded message is an input: one of [`INPUT_TOPICS`], or a line on `rosout` of
+/// a service the replay replaces.
+fn is_input(topic: &str, data: &[u8]) -> Result<bool, CdrError> {
+    let t = topic.trim_start_matches('/');
+    if t == topics::ROSOUT.name {
+        let line: LogLine = decode(data)?;
+        return Ok(INPUT_LOG_NAMES.contains(&line.name()));
+    }
+    Ok(INPUT_TOPICS.contains(&t))
 }
 
 /// Decodes one recorded message if it is an input. The MCAP `sequence` carries a frame's
@@ -44,6 +64,14 @@ pub fn decode_input<'a>(topic: &str, sequence: u32, data: &'a [u8]) -> Result<Op
             let (mut header, pixels) = decode_image(data)?;
             header.seq = u64::from(sequence);
             Input::Frame { header, pixels }
+        }
+        _ if t == topics::ROSOUT.name => {
+            let mut line: LogLine = decode(data)?;
+            if !INPUT_LOG_NAMES.contains(&line.name()) {
+                return Ok(None);
+            }
+            line.header.seq = u64::from(sequence);
+            Input::Log(Box::new(line))
         }
         _ => return Ok(None),
     }))
@@ -93,7 +121,7 @@ pub fn for_each_tick<E: From<RecordingError>>(
     };
     for m in recording.messages()? {
         let m = m?;
-        if !INPUT_TOPICS.contains(&m.topic()) {
+        if !is_input(m.topic(), m.data()).map_err(|e| m.undecodable(e))? {
             continue;
         }
         if let Some(t) = tick

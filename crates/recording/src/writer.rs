@@ -58,6 +58,8 @@ pub struct ChannelStats {
     /// Sequence numbers skipped: messages the recorder never saw (or a publisher restart).
     pub seq_gaps: u64,
     last_seq: Option<u64>,
+    /// Several publishers number their own messages here (`rosout`): gaps are not counted.
+    shared: bool,
 }
 
 /// An open recording.
@@ -108,7 +110,8 @@ impl Recorder {
             .writer
             .add_channel(schema, &format!("/{topic}"), "cdr", &metadata)
             .map_err(|e| self.err(e))?;
-        self.channels.push((id, ChannelStats { topic: topic.to_owned(), ..Default::default() }));
+        let shared = topic == harvey_msgs::topics::ROSOUT.name;
+        self.channels.push((id, ChannelStats { topic: topic.to_owned(), shared, ..Default::default() }));
         Ok(Channel(self.channels.len() - 1))
     }
 
@@ -143,7 +146,7 @@ impl Recorder {
         data: &[u8],
     ) -> Result<(), RecordingError> {
         let (id, stats) = &mut self.channels[ch.0];
-        if let Some(last) = stats.last_seq {
+        if let Some(last) = stats.last_seq.filter(|_| !stats.shared) {
             stats.seq_gaps += seq.saturating_sub(last + 1);
         }
         stats.last_seq = Some(seq);
@@ -224,7 +227,9 @@ impl Recorder {
         let mut metadata = BTreeMap::new();
         for (_, s) in &self.channels {
             metadata.insert(format!("{}.messages", s.topic), s.messages.to_string());
-            metadata.insert(format!("{}.seq_gaps", s.topic), s.seq_gaps.to_string());
+            if !s.shared {
+                metadata.insert(format!("{}.seq_gaps", s.topic), s.seq_gaps.to_string());
+            }
         }
         let record = Metadata { name: RECORDER_METADATA.into(), metadata };
         self.writer.write_metadata(&record).map_err(|e| self.err(e))?;

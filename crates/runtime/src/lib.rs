@@ -1,5 +1,6 @@
 //! What every Harvey service process shares: logging set-up, the readiness handshake with
-//! the supervisor, and [`checkpoint`]s of a service's state across restarts.
+//! the supervisor, [`checkpoint`]s of a service's state across restarts, and its warnings on
+//! `rosout` ([`rosout`]).
 //!
 //! Readiness: the supervisor passes a pipe's write end in `$HARVEY_READY_FD`; a service calls
 //! [`notify_ready`] once its ports exist, which writes `READY\n` and closes the pipe. A service
@@ -8,10 +9,12 @@
 pub mod checkpoint;
 pub mod journal;
 pub mod resume;
+pub mod rosout;
 
 pub use checkpoint::{Checkpoint, CheckpointError, STATE_DIR_ENV};
 pub use journal::Journal;
 pub use resume::{Marks, Resume, Sent};
+pub use rosout::Rosout;
 
 use std::io::Write;
 use std::os::fd::FromRawFd;
@@ -24,17 +27,20 @@ pub const SUPERVISED_ENV: &str = "HARVEY_SUPERVISED";
 pub const READY_LINE: &[u8] = b"READY\n";
 
 /// Logs to stderr, filtered by `RUST_LOG` (default `info`). Under the supervisor, which prefixes
-/// and timestamps lines itself, lines are plain.
+/// and timestamps lines itself, lines are plain. WARN and ERROR events of a turn are also
+/// captured for [`Rosout`], whatever `RUST_LOG` says (what is recorded must not depend on it).
 pub fn init_logging() {
+    use tracing_subscriber::Layer;
+    use tracing_subscriber::layer::SubscriberExt;
+    use tracing_subscriber::util::SubscriberInitExt;
     let supervised = std::env::var_os(SUPERVISED_ENV).is_some();
     let filter = tracing_subscriber::EnvFilter::try_from_default_env()
         .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info"));
-    let builder = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr);
-    if supervised {
-        builder.without_time().with_ansi(false).with_target(false).init();
-    } else {
-        builder.init();
-    }
+    let fmt = tracing_subscriber::fmt::layer().with_writer(std::io::stderr);
+    let fmt =
+        if supervised { fmt.without_time().with_ansi(false).with_target(false).boxed() } else { fmt.boxed() };
+    let capture = rosout::CaptureLayer.with_filter(tracing_subscriber::filter::LevelFilter::WARN);
+    tracing_subscriber::registry().with(fmt.with_filter(filter)).with(capture).init();
 }
 
 /// Tells the supervisor this service is ready. Idempotent: only the first call writes.

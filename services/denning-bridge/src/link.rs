@@ -9,7 +9,7 @@ use harvey_denning_bridge::{BridgeState, Outgoing, Source, WATCHDOG_STOP_ID, pri
 use harvey_drv_protocol::serial::write_frame;
 use harvey_drv_protocol::{Command, Line, encode};
 use harvey_msgs::{EncodersRaw, MissionStatus, MotionCommand, SonarRaw};
-use harvey_runtime::Checkpoint;
+use harvey_runtime::{Checkpoint, Rosout};
 
 /// Why the loop over one connection ended.
 pub enum Ended {
@@ -22,6 +22,8 @@ pub struct Link<'a> {
     pub port: File,
     pub state: &'a mut BridgeState,
     pub checkpoint: Option<&'a mut Checkpoint>,
+    /// The bridge's warnings, published with each tick it starts (lockstep) or each wake-up.
+    pub rosout: Rosout,
 }
 
 impl Link<'_> {
@@ -109,7 +111,13 @@ pub fn publish(
         }
         Outgoing::Tick { time_ms } => {
             match lockstep {
-                Some(l) => l.finish(time_ms * 1_000_000)?,
+                Some(l) => {
+                    // What went wrong since the last tick goes out with this one, before the
+                    // chain starts on it.
+                    link.rosout.end(time_ms * 1_000_000)?;
+                    link.rosout.begin();
+                    l.finish(time_ms * 1_000_000)?
+                }
                 None => tracing::warn!(time_ms, "a tick mark from the DRV in real-time mode"),
             }
             None

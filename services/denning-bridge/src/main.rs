@@ -82,7 +82,8 @@ fn main() -> anyhow::Result<()> {
     harvey_runtime::notify_ready()?;
     tracing::info!(device = %args.device.display(), lockstep = lockstep.is_some(), "bridge up");
 
-    let mut link = Link { port, state: &mut state, checkpoint: checkpoint.as_mut() };
+    let rosout = harvey_runtime::Rosout::new(&bus, "denning-bridge")?;
+    let mut link = Link { port, state: &mut state, checkpoint: checkpoint.as_mut(), rosout };
     let result = loop {
         // After a hang-up or a restart the DRV may have missed the last round: it goes again
         // (the DRV answers a round it has already run with that tick's lines, which the bridge
@@ -92,7 +93,10 @@ fn main() -> anyhow::Result<()> {
                 link.send_raw(&frame)?;
             }
         }
-        match run(&args, &mut link, &lockstep, &waiter, &ports, &reoffers) {
+        let ended = run(&args, &mut link, &lockstep, &waiter, &ports, &reoffers);
+        // Reopening the line is plumbing, not the run's: its warnings stay off `rosout`.
+        link.rosout.pause();
+        match ended {
             Ok(Ended::Shutdown) => break Ok(()),
             Ok(Ended::HungUp) => {
                 tracing::warn!(device = %args.device.display(), "the DRV line hung up: reopening");
@@ -164,6 +168,7 @@ fn run(
     };
     let mut decoder = Decoder::new();
     let (mut buf, mut batch, mut ticks, mut round) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    link.rosout.begin();
     loop {
         if waiter.wait(None)? == Wake::Shutdown {
             tracing::info!(stats = ?decoder.stats(), "bridge stopped");
@@ -218,6 +223,11 @@ fn run(
                 continue;
             }
             publish(args.watchdog_ms, link, lockstep, ports, line)?;
+        }
+        // Real time: no tick marks; the warnings go out stamped with the vehicle's time.
+        if lockstep.is_none() {
+            link.rosout.end(link.state.watchdog.now_ms() * 1_000_000)?;
+            link.rosout.begin();
         }
     }
 }

@@ -5,7 +5,7 @@
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_encoders::OdometryBuilder;
 use harvey_msgs::{Message, topics};
-use harvey_runtime::Resume;
+use harvey_runtime::{Resume, Rosout};
 
 /// Room for the builder and the marks of its three inputs.
 const SLOT_BYTES: usize = 4 << 10;
@@ -17,6 +17,7 @@ fn main() -> anyhow::Result<()> {
     let commands = bus.subscriber(topics::VEHICLE_COMMAND)?;
     let reflexes = bus.subscriber(topics::VEHICLE_REFLEX)?;
     let odometry = bus.publisher(topics::ODOMETRY)?;
+    let mut rosout = Rosout::new(&bus, "encoders")?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&raw, &commands, &reflexes])?;
@@ -33,7 +34,9 @@ fn main() -> anyhow::Result<()> {
             resume.fresh(topic, m.header().stamp_ns, m.header().seq)
         });
     };
-    while pace.next(&waiter, None)? != Step::Stop {
+    let mut newest = 0;
+    while let Step::Go(tick) = pace.next(&waiter, None)? {
+        rosout.begin();
         commands.drain_into(&mut cmds)?;
         fresh(&mut resume, commands.topic(), &mut cmds);
         cmds.iter().for_each(|c| resume.state().on_command(c));
@@ -42,6 +45,7 @@ fn main() -> anyhow::Result<()> {
         cmds.iter().for_each(|c| resume.state().on_command(c));
         raw.drain_into(&mut reports)?;
         reports.retain(|r| resume.fresh(raw.topic(), r.header.stamp_ns, r.header.seq));
+        newest = reports.iter().map(|r| r.header.stamp_ns).fold(newest, u64::max);
         for r in &reports {
             match resume.state().on_encoders(r) {
                 Ok(odo) => {
@@ -54,6 +58,7 @@ fn main() -> anyhow::Result<()> {
                 Err(e) => tracing::warn!("dropping an encoder report: {e}"),
             }
         }
+        rosout.end(tick.unwrap_or(newest))?;
         resume.tick_done()?;
         pace.done()?;
     }

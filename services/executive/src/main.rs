@@ -146,6 +146,7 @@ fn main() -> anyhow::Result<()> {
     let pose_pub = bus.publisher(topics::EXECUTIVE_POSE)?;
     let behaviour_pub = bus.publisher(topics::EXECUTIVE_BEHAVIOUR)?;
     let plan_pub = bus.publisher(topics::EXECUTIVE_PLAN)?;
+    let mut rosout = harvey_runtime::Rosout::new(&bus, "executive")?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps, &results])?;
@@ -170,11 +171,17 @@ fn main() -> anyhow::Result<()> {
     };
     let mut sent = Sent::from_env("executive")?;
     let mut tick = Tick::default();
+    let mut latest_ns = 0;
     while exec.state() == MissionState::Running {
-        if pace.next(&waiter, None)? == Step::Stop {
-            tracing::warn!("stopped before the mission ended");
-            return Ok(());
-        }
+        let turn = match pace.next(&waiter, None)? {
+            Step::Go(turn) => turn,
+            Step::Idle => continue,
+            Step::Stop => {
+                tracing::warn!("stopped before the mission ended");
+                return Ok(());
+            }
+        };
+        rosout.begin();
         let fresh =
             |marks: &mut Marks, topic: &str, h: &harvey_msgs::Header| marks.fresh(topic, h.stamp_ns, h.seq);
         sonar.drain_into(&mut tick.rings)?;
@@ -192,11 +199,12 @@ fn main() -> anyhow::Result<()> {
         tick.results.retain(|m| fresh(&mut marks, results.topic(), &m.header));
         odometry.drain_into(&mut tick.odos)?;
         tick.odos.retain(|m| fresh(&mut marks, odometry.topic(), &m.header));
+        latest_ns = tick.odos.iter().map(|o| o.header.stamp_ns).fold(latest_ns, u64::max);
         let out = step(&mut exec, &tick);
         for o in &out {
             match o {
                 Output::Command(c) => {
-                    tracing::info!(
+                    tracing::debug!(
                         id = c.command_id,
                         kind = c.kind,
                         distance_m = c.distance_m,
@@ -225,6 +233,7 @@ fn main() -> anyhow::Result<()> {
                 }
             }
         }
+        rosout.end(turn.unwrap_or(latest_ns))?;
         if let Some(j) = journal.as_mut() {
             j.append(&Journaled::encode(&tick))?;
         }

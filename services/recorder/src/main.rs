@@ -139,6 +139,7 @@ fn main() -> anyhow::Result<()> {
         tap(&bus, &mut rec, topics::EXECUTIVE_BEHAVIOUR)?,
         tap(&bus, &mut rec, topics::VISION_REQUESTS)?,
         tap(&bus, &mut rec, topics::VISION_RESULTS)?,
+        tap(&bus, &mut rec, topics::ROSOUT)?,
         Box::new(FrameTap { sub: bus.frame_subscriber(topics::CAMERA_FRAME)?, channel: frame_channel }),
     ];
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();

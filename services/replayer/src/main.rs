@@ -72,6 +72,7 @@ fn main() -> anyhow::Result<()> {
     let truth = bus.publisher(topics::SIM_TRUTH)?;
     let sonar = bus.publisher(topics::DRV_SONAR_RAW)?;
     let encoders = bus.publisher(topics::DRV_ENCODERS_RAW)?;
+    let rosout = bus.publisher(topics::ROSOUT)?;
     let frames = (contents.max_frame_bytes > 0)
         .then(|| bus.frame_publisher(topics::CAMERA_FRAME, contents.max_frame_bytes))
         .transpose()?;
@@ -105,6 +106,7 @@ fn main() -> anyhow::Result<()> {
                 Input::Truth(m) => truth.send(m).map(drop)?,
                 Input::Sonar(m) => sonar.send(m).map(drop)?,
                 Input::Encoders(m) => encoders.send(m).map(drop)?,
+                Input::Log(m) => rosout.send(m.as_ref()).map(drop)?,
                 Input::Frame { header, pixels } => {
                     let publisher = frames.as_ref().context("a frame the first pass did not see")?;
                     let mut loan = publisher.loan(*header)?;

@@ -57,6 +57,7 @@ fn main() -> anyhow::Result<()> {
     let odometry = bus.subscriber(topics::ODOMETRY)?;
     let ring_pub = bus.publisher(topics::SONAR_RING)?;
     let command_pub = bus.publisher(topics::VEHICLE_REFLEX)?;
+    let mut rosout = harvey_runtime::Rosout::new(&bus, "sonar")?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&raw, &odometry])?;
@@ -81,12 +82,14 @@ fn main() -> anyhow::Result<()> {
         tracing::warn!("resumed from the checkpoint");
     }
     let (mut banks, mut poses) = (Vec::new(), Vec::new());
-    let mut rings = 0u64;
-    while pace.next(&waiter, None)? != Step::Stop {
+    let (mut rings, mut newest) = (0u64, 0);
+    while let Step::Go(tick) = pace.next(&waiter, None)? {
+        rosout.begin();
         odometry.drain_into(&mut poses)?;
         poses.retain(|m| resume.fresh(odometry.topic(), m.header().stamp_ns, m.header().seq));
         raw.drain_into(&mut banks)?;
         banks.retain(|m| resume.fresh(raw.topic(), m.header().stamp_ns, m.header().seq));
+        newest = banks.iter().map(|b| b.header.stamp_ns).fold(newest, u64::max);
         for o in &poses {
             if let Some(c) = resume.state().1.as_mut().and_then(|a| a.on_odometry(o)) {
                 tracing::warn!(command = c.command_id, kind = c.kind, "panic-avoid");
@@ -111,6 +114,7 @@ fn main() -> anyhow::Result<()> {
                 Err(e) => tracing::warn!("dropping a sonar report: {e}"),
             }
         }
+        rosout.end(tick.unwrap_or(newest))?;
         resume.tick_done()?;
         pace.done()?;
     }

@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::topics;
-use harvey_runtime::Sent;
+use harvey_runtime::{Rosout, Sent};
 use harvey_ums::{Config, Output, Ums};
 
 #[derive(Parser)]
@@ -83,6 +83,7 @@ fn main() -> anyhow::Result<()> {
     let fixes = bus.subscriber(topics::EXECUTIVE_POSE)?;
     let map_pub = bus.publisher(topics::UMS_MAP)?;
     let expectations = bus.publisher(topics::UMS_EXPECTATIONS)?;
+    let mut rosout = Rosout::new(&bus, "ums")?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
     let _a = pace.attach(&waiter, &[&odometry, &sightings, &fixes])?;
@@ -100,7 +101,9 @@ fn main() -> anyhow::Result<()> {
         );
     }
     let (mut odos, mut seen, mut fixed) = (Vec::new(), Vec::new(), Vec::new());
-    while pace.next(&waiter, None)? != Step::Stop {
+    let mut newest = 0;
+    while let Step::Go(tick) = pace.next(&waiter, None)? {
+        rosout.begin();
         sightings.drain_into(&mut seen)?;
         seen.retain(|m| resume.fresh(sightings.topic(), m.header.stamp_ns, m.header.seq));
         for s in &seen {
@@ -117,6 +120,7 @@ fn main() -> anyhow::Result<()> {
         }
         odometry.drain_into(&mut odos)?;
         odos.retain(|m| resume.fresh(odometry.topic(), m.header.stamp_ns, m.header.seq));
+        newest = odos.iter().map(|o| o.header.stamp_ns).fold(newest, u64::max);
         for o in &odos {
             match ums.on_odometry(o) {
                 Ok(out) => {
@@ -131,6 +135,7 @@ fn main() -> anyhow::Result<()> {
                 Err(e) => tracing::warn!("rejected: {e}"),
             }
         }
+        rosout.end(tick.unwrap_or(newest))?;
         *resume.state() = ums.state();
         resume.tick_done()?;
         pace.done()?;

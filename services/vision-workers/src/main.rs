@@ -151,8 +151,10 @@ fn main() -> anyhow::Result<()> {
         tracing::warn!(requests = asked.len(), expectations = wanted.len(), "resumed from the checkpoint");
     }
     let max_age_ns = args.expectation_max_age_ms * 1_000_000;
-    let (mut processed, mut found) = (0u64, 0u64);
-    while pace.next(&waiter, None)? != Step::Stop {
+    let mut rosout = harvey_runtime::Rosout::new(&bus, "vision-workers")?;
+    let (mut processed, mut found, mut newest) = (0u64, 0u64, 0);
+    while let Step::Go(tick) = pace.next(&waiter, None)? {
+        rosout.begin();
         expectations.drain(|e| {
             if resume.fresh(expectations.topic(), e.header.stamp_ns, e.header.seq) {
                 wanted.insert(e.landmark_index, *e);
@@ -167,11 +169,13 @@ fn main() -> anyhow::Result<()> {
         let frame =
             frames.latest()?.filter(|f| resume.fresh(frames.topic(), f.header().stamp_ns, f.header().seq));
         let Some(frame) = frame else {
+            rosout.end(tick.unwrap_or(newest))?;
             keep(&mut resume, &asked, &wanted, [edges.numbered(), lines.numbered(), dispatcher.numbered()])?;
             pace.done()?;
             continue;
         };
         let h = *frame.header();
+        newest = newest.max(h.stamp_ns);
         match edges.run(&h, frame.pixels()) {
             Ok(d) => {
                 send(&mut sent, &detections, &d)?;
@@ -192,6 +196,7 @@ fn main() -> anyhow::Result<()> {
         }
         asked.retain(|_, r| r.standing != 0);
         drop(frame);
+        rosout.end(tick.unwrap_or(newest))?;
         keep(&mut resume, &asked, &wanted, [edges.numbered(), lines.numbered(), dispatcher.numbered()])?;
         pace.done()?;
     }

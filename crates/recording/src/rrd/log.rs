@@ -2,10 +2,13 @@
 //! UMS losing and finding the robot at INFO or WARN, each under its source (`log/executive`,
 //! `log/ums`, `log/sonar`); the sonar reflexes at WARN; the motion commands at DEBUG, and only when
 //! they differ from the one before (the executive repeats its command every tick); velocity
-//! commands, new every tick, as plots of speed and turn rate.
+//! commands, new every tick, as plots of speed and turn rate; the services' own warnings and
+//! errors (`rosout`) under their service's name, a line repeated within a few seconds drawn
+//! once with the count of its repeats (the MCAP keeps every one).
 
 use harvey_msgs::{
-    CommandKind, MissionState, MissionStatus, MotionCommand, PANIC_STOP_IDS, REFLEX_ID_BIT, ServoLevel,
+    CommandKind, LogLevel, LogLine, MissionState, MissionStatus, MotionCommand, PANIC_STOP_IDS,
+    REFLEX_ID_BIT, ServoLevel,
 };
 use rerun::TextLogLevel;
 
@@ -21,6 +24,34 @@ pub(super) fn describe(c: &MotionCommand) -> String {
             format!("velocity {:.3} m/s, {:.1} deg/s", c.linear_mps, c.angular_radps.to_degrees())
         }
         None => format!("kind {}", c.kind),
+    }
+}
+
+/// A service's line repeated within this much simulated time is not drawn again.
+const REPEAT_WINDOW_NS: u64 = 5_000_000_000;
+
+/// The `rosout` lines drawn lately: (service, text) → (stamp drawn, repeats since).
+#[derive(Default)]
+pub(super) struct Repeats(std::collections::BTreeMap<(String, String), (u64, u32)>);
+
+impl Repeats {
+    /// Whether a line is drawn, and if so how many repeats of it were held back before it.
+    fn admit(&mut self, source: &str, text: &str, stamp_ns: u64) -> Option<u32> {
+        let key = (source.to_owned(), text.to_owned());
+        match self.0.get_mut(&key) {
+            Some((drawn, held)) if stamp_ns < *drawn + REPEAT_WINDOW_NS => {
+                *held += 1;
+                None
+            }
+            Some((drawn, held)) => {
+                *drawn = stamp_ns;
+                Some(std::mem::take(held))
+            }
+            None => {
+                self.0.insert(key, (stamp_ns, 0));
+                Some(0)
+            }
+        }
     }
 }
 
@@ -116,6 +147,31 @@ impl RrdWriter {
         Ok(())
     }
 
+    /// A service's own warning or error (`rosout`), under `log/<service>` at its level.
+    pub fn rosout(&mut self, l: &LogLine) -> Result<(), RrdError> {
+        let level = match l.level() {
+            Some(LogLevel::Debug) => TextLogLevel::DEBUG,
+            Some(LogLevel::Info) => TextLogLevel::INFO,
+            Some(LogLevel::Warn) => TextLogLevel::WARN,
+            Some(LogLevel::Error | LogLevel::Fatal) | None => TextLogLevel::ERROR,
+        };
+        let source = match l.name() {
+            "" => "unnamed",
+            name => name,
+        };
+        let Some(held) = self.repeats.admit(source, l.text(), l.header.stamp_ns) else {
+            return Ok(());
+        };
+        let text = match held {
+            0 => l.text().to_owned(),
+            n => {
+                format!("{} ({n} more like it in the last {} s)", l.text(), REPEAT_WINDOW_NS / 1_000_000_000)
+            }
+        };
+        self.at(l.header.stamp_ns);
+        self.say(source, level, text)
+    }
+
     /// The UMS's map holding the robot or lost, logged and laned when it changes.
     pub(super) fn ums_state(&mut self, lost: bool) -> Result<(), RrdError> {
         if self.lost == Some(lost) {
@@ -139,6 +195,19 @@ impl RrdWriter {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_repeated_line_is_drawn_once_per_window_with_its_count() {
+        let mut r = Repeats::default();
+        let s = 1_000_000_000;
+        assert_eq!(r.admit("ums", "rejected: x", 0), Some(0));
+        assert_eq!(r.admit("ums", "rejected: x", s), None);
+        assert_eq!(r.admit("ums", "rejected: y", s), Some(0), "another text is drawn");
+        assert_eq!(r.admit("executive", "rejected: x", s), Some(0), "another service is drawn");
+        assert_eq!(r.admit("ums", "rejected: x", 4 * s), None);
+        assert_eq!(r.admit("ums", "rejected: x", 5 * s), Some(2), "drawn again, with the two held back");
+        assert_eq!(r.admit("ums", "rejected: x", 6 * s), None);
+    }
 
     #[test]
     fn a_command_reads_as_what_it_asks_whatever_its_id() {
