@@ -56,6 +56,15 @@ enum Cmd {
         #[command(flatten)]
         opts: LaunchArgs,
     },
+    /// A running domain's topics: `list`, `echo TOPIC`, `hz TOPIC` (as `ros2 topic` does).
+    #[command(subcommand)]
+    Topic(cmd::topic::TopicCmd),
+    /// Prints the iceoryx2 configuration of a bus domain: saved as `config/iceoryx2.toml` where
+    /// `iox2` runs, `iox2 service list` sees the domain's services.
+    Iox2Config {
+        #[arg(long, default_value = harvey_bus::DEFAULT_PREFIX)]
+        prefix: String,
+    },
     /// Topics, counts, rates, duration and gaps of a recording.
     Info { recording: PathBuf },
     /// Salvage a recording whose writer died: every chunk whose CRC checks, into a valid file.
@@ -111,7 +120,7 @@ fn main() {
 fn run(cli: Cli) -> anyhow::Result<i32> {
     let cmd = cli.command.unwrap_or(Cmd::Run {
         mission: None,
-        opts: LaunchArgs { run_dir: None, prefix: harvey_bus::DEFAULT_PREFIX.into() },
+        opts: LaunchArgs { run_dir: None, prefix: harvey_bus::DEFAULT_PREFIX.into(), realtime: false },
     });
     match cmd {
         Cmd::Run { mission, opts } => cmd::run::run(mission.as_deref(), &opts),
@@ -121,6 +130,8 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             cmd::replay::run(&recording, check, rrd, trust_recording, opts)
         }
         Cmd::Info { recording } => cmd::info::run(&recording),
+        Cmd::Topic(t) => cmd::topic::run(&t),
+        Cmd::Iox2Config { prefix } => cmd::topic::iox2_config(&prefix),
         Cmd::Diff { a, b } => cmd::diff::run(&a, &b),
         Cmd::Recover { recording, output } => cmd::recover::run(&recording, &output),
         Cmd::Export { recording, output } => cmd::export::run(&recording, &output),

@@ -17,7 +17,10 @@ pub fn supervise(file: &Path, args: &LaunchArgs) -> anyhow::Result<i32> {
     let Some(mut line) = harvey_supervisor::KeeperLine::from_env()? else {
         anyhow::bail!("`harvey supervise` runs under a keeper: use `harvey launch {}`", file.display());
     };
-    let lf = harvey_supervisor::LaunchFile::load(file)?;
+    let mut lf = harvey_supervisor::LaunchFile::load(file)?;
+    if args.realtime {
+        lf.settings.clock = harvey_supervisor::ClockMode::Realtime;
+    }
     let outcome = harvey_supervisor::run(&lf, &launch_options(&lf, args), &mut line)?;
     line.report(&outcome)?;
     Ok(outcome.exit_code())

@@ -11,6 +11,7 @@ pub mod replay;
 mod replay_launch;
 pub mod run;
 pub mod sweep;
+pub mod topic;
 
 use std::path::{Path, PathBuf};
 
@@ -23,6 +24,10 @@ pub struct LaunchArgs {
     /// Bus domain prefix; runs with different prefixes never see each other.
     #[arg(long, default_value = harvey_bus::DEFAULT_PREFIX)]
     pub prefix: String,
+    /// Pace the launch by the wall clock (`clock = "realtime"`), as a real robot is, whatever
+    /// its file says: to watch a run as it happens. Not deterministic.
+    #[arg(long)]
+    pub realtime: bool,
 }
 
 /// Where launch file `lf` runs, given `args`.
@@ -43,6 +48,9 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
     let make = || {
         let mut cmd = std::process::Command::new(&exe);
         cmd.arg("supervise").arg(file).arg("--run-dir").arg(&opts.run_dir).args(["--prefix", &opts.prefix]);
+        if args.realtime {
+            cmd.arg("--realtime");
+        }
         cmd
     };
     let grace = std::time::Duration::from_millis(lf.settings.grace_period_ms);

@@ -18,6 +18,10 @@ const WRITTEN: [&str; 4] = ["run.mcap", "run.rrd", "world.toml", LAUNCH_FILE];
 pub fn run(recording: &Path, check: bool, rrd: bool, trust: bool, opts: LaunchArgs) -> anyhow::Result<i32> {
     // Every argument is checked before anything is written.
     harvey_bus::validate_prefix(&opts.prefix)?;
+    anyhow::ensure!(
+        !opts.realtime,
+        "--realtime: a replay is deterministic (the replayer hands the services each recorded tick in turn)"
+    );
     let run_dir =
         opts.run_dir.clone().unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
     refuse_writing_over(recording, &run_dir)?;
@@ -76,7 +80,8 @@ mod tests {
         let e = prepare(&recording, &run_dir, false, false).expect_err("refused").to_string();
         assert!(e.contains("ums (/bin/sh)") && e.contains("--trust-recording"), "{e}");
         assert!(!run_dir.exists(), "nothing is written for a refused replay");
-        let opts = LaunchArgs { run_dir: Some(dir.join("other")), prefix: "bad prefix".into() };
+        let opts =
+            LaunchArgs { run_dir: Some(dir.join("other")), prefix: "bad prefix".into(), realtime: false };
         assert!(run(&recording, false, false, false, opts).is_err(), "a bad prefix is refused");
         assert!(!dir.join("other").exists(), "before anything is written");
         std::fs::remove_dir_all(&dir).ok();

@@ -15,6 +15,7 @@ mod clock;
 mod domain;
 mod error;
 mod frames;
+mod listing;
 mod pubsub;
 mod reoffer;
 mod shm;
@@ -26,6 +27,7 @@ pub use domain::{
 };
 pub use error::BusError;
 pub use frames::{Frame, FrameLoan, FramePublisher, FrameSubscriber};
+pub use listing::{TopicInfo, iceoryx2_config, topics};
 pub use pubsub::{Publisher, Subscriber};
 pub use reoffer::{REOFFERED, ReofferRequests, Reoffers};
 pub use shm::domain_files;

@@ -108,6 +108,11 @@ impl<'a> CdrReader<'a> {
         self.take(n)
     }
 
+    /// Where the next read starts, from the message's first byte.
+    pub fn offset(&self) -> usize {
+        self.pos
+    }
+
     /// Bytes left unread.
     pub fn remaining(&self) -> usize {
         self.data.len() - self.pos
@@ -144,7 +149,7 @@ macro_rules! primitive {
         }
     )*};
 }
-primitive!(u8, i32, u32, u64, i64, f32, f64);
+primitive!(u8, i8, u16, i16, i32, u32, u64, i64, f32, f64);
 
 /// A value with a CDR form.
 pub trait Cdr: Sized {

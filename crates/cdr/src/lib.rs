@@ -3,10 +3,12 @@
 //! read Harvey's recordings without Harvey's code. Decoding serves replay and `harvey info`.
 
 mod codec;
+mod dynamic;
 mod log;
 mod schema;
 mod types;
 
 pub use codec::{Cdr, CdrError, CdrReader, CdrWriter, decode, encode};
+pub use dynamic::{Schema, SchemaError};
 pub use schema::{Def, full_text};
 pub use types::{Ros2Msg, decode_image, encode_image, image_def};

@@ -29,7 +29,7 @@ mod supervisor;
 mod wait;
 
 pub use child::SpawnError;
-pub use config::{LaunchError, LaunchFile};
+pub use config::{ClockMode, LaunchError, LaunchFile};
 pub use error::SupervisorError;
 pub use keeper::{Kept, keep};
 pub use keeper_line::KeeperLine;
