@@ -120,7 +120,12 @@ fn main() {
 fn run(cli: Cli) -> anyhow::Result<i32> {
     let cmd = cli.command.unwrap_or(Cmd::Run {
         mission: None,
-        opts: LaunchArgs { run_dir: None, prefix: harvey_bus::DEFAULT_PREFIX.into(), realtime: false },
+        opts: LaunchArgs {
+            run_dir: None,
+            prefix: harvey_bus::DEFAULT_PREFIX.into(),
+            realtime: false,
+            live: None,
+        },
     });
     match cmd {
         Cmd::Run { mission, opts } => cmd::run::run(mission.as_deref(), &opts),

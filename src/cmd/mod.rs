@@ -6,6 +6,7 @@ pub mod diff;
 pub mod export;
 pub mod info;
 pub mod launch;
+mod live;
 pub mod recover;
 pub mod replay;
 mod replay_launch;
@@ -28,6 +29,11 @@ pub struct LaunchArgs {
     /// its file says: to watch a run as it happens. Not deterministic.
     #[arg(long)]
     pub realtime: bool,
+    /// Also stream the recorder's Rerun drawing live to a viewer: at URL
+    /// (`rerun+http://HOST:PORT/proxy`), or without one to the viewer at Rerun's default address,
+    /// started (`rerun` on the PATH or in `.venv`) if none answers there. The MCAP is unchanged.
+    #[arg(long, num_args = 0..=1, default_missing_value = "", value_name = "URL")]
+    pub live: Option<String>,
 }
 
 /// Where launch file `lf` runs, given `args`.
@@ -43,6 +49,13 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
     let lf = harvey_supervisor::LaunchFile::load(file)?;
     let opts = launch_options(&lf, args);
     harvey_bus::validate_prefix(&opts.prefix)?;
+    if let Some(url) = &args.live {
+        let url = live::viewer(url)?;
+        println!("live: drawing to the Rerun viewer at {url}");
+        // SAFETY: the CLI is single-threaded here, before it starts any process or thread; the
+        // recorder, a child of this keeper process, reads the variable.
+        unsafe { std::env::set_var(live::LIVE_ENV, &url) };
+    }
     tracing::info!(launch = %lf.settings.name, run_dir = %opts.run_dir.display(), prefix = %opts.prefix, "launching {} services", lf.services.len());
     let exe = std::env::current_exe()?;
     let make = || {

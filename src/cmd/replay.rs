@@ -25,7 +25,8 @@ pub fn run(recording: &Path, check: bool, rrd: bool, trust: bool, opts: LaunchAr
     let run_dir =
         opts.run_dir.clone().unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
     refuse_writing_over(recording, &run_dir)?;
-    let file = prepare(recording, &run_dir, rrd, trust)?;
+    // A live view is drawn from the Rerun file's stream.
+    let file = prepare(recording, &run_dir, rrd || opts.live.is_some(), trust)?;
     println!("replaying: {} (the launch {} carries)", file.display(), recording.display());
     let (outcome, _) = launch_file(&file, &LaunchArgs { run_dir: Some(run_dir.clone()), ..opts })?;
     println!("replay: {outcome:?}");
@@ -80,8 +81,12 @@ mod tests {
         let e = prepare(&recording, &run_dir, false, false).expect_err("refused").to_string();
         assert!(e.contains("ums (/bin/sh)") && e.contains("--trust-recording"), "{e}");
         assert!(!run_dir.exists(), "nothing is written for a refused replay");
-        let opts =
-            LaunchArgs { run_dir: Some(dir.join("other")), prefix: "bad prefix".into(), realtime: false };
+        let opts = LaunchArgs {
+            run_dir: Some(dir.join("other")),
+            prefix: "bad prefix".into(),
+            realtime: false,
+            live: None,
+        };
         assert!(run(&recording, false, false, false, opts).is_err(), "a bad prefix is refused");
         assert!(!dir.join("other").exists(), "before anything is written");
         std::fs::remove_dir_all(&dir).ok();

@@ -26,7 +26,15 @@ pub enum RrdError {
     /// What is logged could not be pushed to the file.
     #[error("recording {file}: {cause}")]
     Flush { file: PathBuf, cause: rerun::sink::SinkFlushError },
+    /// A live viewer's address that is not a Rerun proxy URL.
+    #[error("live viewer `{url}`: {what} (a viewer's address reads rerun+http://HOST:PORT/proxy)")]
+    LiveUrl { url: String, what: String },
 }
+
+/// How long a flush waits for a live viewer before it goes on without it (the file is flushed
+/// all the same): a viewer that is gone must not hold up the recording.
+const LIVE_FLUSH_TIMEOUT: std::time::Duration = std::time::Duration::from_millis(200);
+const LIVE_FINISH_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(5);
 
 fn up(p: [f64; 2]) -> [f32; 2] {
     [p[0] as f32, -p[1] as f32]
@@ -109,6 +117,8 @@ pub struct RrdWriter {
     lost: Option<bool>,
     /// The services' `rosout` lines drawn lately, so a repeated one is drawn once a while.
     repeats: log::Repeats,
+    /// Also streamed to a live viewer: flushes wait for it only briefly.
+    live: bool,
 }
 
 /// Paths keep a point every 5 cm, a few thousand at most.
@@ -118,10 +128,28 @@ const TRAIL_CAP: usize = 4000;
 impl RrdWriter {
     /// Creates the file with Harvey's blueprint, and draws the world's walls and landmarks.
     pub fn create(path: &Path, world: Option<&World>) -> Result<Self, RrdError> {
-        let rec = rerun::RecordingStreamBuilder::new("harvey")
-            .with_blueprint(blueprint::harvey())
-            .save(path)
-            .map_err(|cause| RrdError::Log { file: path.to_owned(), cause })?;
+        Self::create_live(path, world, None)
+    }
+
+    /// As [`RrdWriter::create`], and with `live` (a viewer's `rerun+http://…/proxy` address) the
+    /// same drawing is streamed to that viewer over gRPC while it is written to the file.
+    pub fn create_live(path: &Path, world: Option<&World>, live: Option<&str>) -> Result<Self, RrdError> {
+        let builder = rerun::RecordingStreamBuilder::new("harvey").with_blueprint(blueprint::harvey());
+        let log_err = |cause| RrdError::Log { file: path.to_owned(), cause };
+        let rec = match live {
+            None => builder.save(path).map_err(log_err)?,
+            Some(url) => {
+                let bad = |what: String| RrdError::LiveUrl { url: url.to_owned(), what };
+                let parsed: rerun::external::re_uri::RedapUri =
+                    url.parse().map_err(|e| bad(format!("{e}")))?;
+                let rerun::external::re_uri::RedapUri::Proxy(proxy) = parsed else {
+                    return Err(bad("not a proxy endpoint".into()));
+                };
+                let file = rerun::sink::FileSink::new(path)
+                    .map_err(|e| log_err(rerun::RecordingStreamError::from(e)))?;
+                builder.set_sinks((rerun::sink::GrpcSink::new(proxy), file)).map_err(log_err)?
+            }
+        };
         let camera =
             world.map(|w| (w.camera.focal_px, f64::from(w.camera.width_px), f64::from(w.camera.height_px)));
         let half_fov_rad = camera.map_or(30f64.to_radians(), |(f, w, _)| (w / 2.0 / f).atan());
@@ -152,6 +180,7 @@ impl RrdWriter {
             last_reflex: None,
             lost: None,
             repeats: log::Repeats::default(),
+            live: live.is_some(),
         };
         w.name_the_plots()?;
         w.draw_world()?;
@@ -195,12 +224,31 @@ impl RrdWriter {
 
     /// Pushes what is logged so far to the file.
     pub fn flush(&self) -> Result<(), RrdError> {
-        self.rec.flush_blocking().map_err(|cause| RrdError::Flush { file: self.path.clone(), cause })
+        let flushed = if self.live {
+            self.rec.flush_with_timeout(LIVE_FLUSH_TIMEOUT)
+        } else {
+            self.rec.flush_blocking()
+        };
+        match flushed {
+            // A viewer that does not keep up, or has gone, is left behind: the file sink has
+            // taken what was drawn, and the run goes on.
+            Err(e) if self.live => {
+                tracing::debug!("the live viewer: {e}");
+                Ok(())
+            }
+            other => other.map_err(|cause| RrdError::Flush { file: self.path.clone(), cause }),
+        }
     }
 
     /// Flushes and closes the file (the footer is written when the stream drops).
     pub fn finish(self) -> Result<(), RrdError> {
         self.flush()?;
+        if self.live {
+            // The end of the run: a live viewer gets a few seconds to take the rest.
+            if let Err(e) = self.rec.flush_with_timeout(LIVE_FINISH_TIMEOUT) {
+                tracing::warn!("the live viewer did not take the end of the run: {e}");
+            }
+        }
         drop(self.rec);
         Ok(())
     }

@@ -28,6 +28,24 @@ const TICKS_PER_BATCH: usize = 8;
 /// …or sooner, once they hold this many bytes.
 const BATCH_BYTES: usize = 8 << 20;
 
+/// The live viewer's address `harvey run --live` hands its recorder.
+const LIVE_ENV: &str = "HARVEY_RERUN_LIVE";
+
+/// Whether something accepts connections at a `rerun+http://HOST:PORT/proxy` address.
+fn viewer_answers(url: &str) -> anyhow::Result<()> {
+    use std::net::ToSocketAddrs;
+    let rest = url.split_once("://").map_or(url, |(_, r)| r);
+    let host_port = rest.split('/').next().unwrap_or(rest);
+    let addrs: Vec<_> =
+        host_port.to_socket_addrs().with_context(|| format!("`{host_port}` is not HOST:PORT"))?.collect();
+    let timeout = std::time::Duration::from_secs(1);
+    anyhow::ensure!(
+        addrs.iter().any(|a| std::net::TcpStream::connect_timeout(a, timeout).is_ok()),
+        "nothing answers at {host_port}"
+    );
+    Ok(())
+}
+
 #[derive(Parser)]
 #[command(about = "Record every topic to an MCAP file")]
 struct Args {
@@ -40,6 +58,11 @@ struct Args {
     /// Also draw the run into this Rerun (.rrd) file.
     #[arg(long)]
     rrd: Option<PathBuf>,
+    /// With `--rrd`, also stream the drawing live to the Rerun viewer at this address
+    /// (`rerun+http://HOST:PORT/proxy`; default: `$HARVEY_RERUN_LIVE`, which `harvey run
+    /// --live` sets).
+    #[arg(long)]
+    live: Option<String>,
     /// The world file of the run: attached to the MCAP file and drawn in the Rerun file.
     #[arg(long)]
     world: Option<PathBuf>,
@@ -117,7 +140,21 @@ fn main() -> anyhow::Result<()> {
             rec.attach_data(&file, &bytes)?;
         }
     }
-    let mut rrd = args.rrd.as_ref().map(|p| RrdWriter::create(p, world.as_ref())).transpose()?;
+    let live = args.live.clone().or_else(|| std::env::var(LIVE_ENV).ok().filter(|u| !u.is_empty()));
+    // rerun's gRPC sink holds the stream up until it has connected: a viewer that does not
+    // answer now is not waited for; the file is drawn all the same.
+    let live = live.filter(|url| match viewer_answers(url) {
+        Ok(()) => true,
+        Err(e) => {
+            tracing::warn!(url, "not drawing live: {e}");
+            false
+        }
+    });
+    if let (Some(url), Some(_)) = (&live, &args.rrd) {
+        tracing::info!(url, "drawing live to a Rerun viewer");
+    }
+    let mut rrd =
+        args.rrd.as_ref().map(|p| RrdWriter::create_live(p, world.as_ref(), live.as_deref())).transpose()?;
     let bus = Bus::join("recorder")?;
     let frame_channel = rec.image_channel(topics::CAMERA_FRAME.name)?;
     let taps: Vec<Box<dyn Tap>> = vec![
