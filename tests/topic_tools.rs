@@ -107,3 +107,75 @@ fn a_realtime_run_is_listed_echoed_and_timed_from_outside() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// The camera's frames have room for the recorder, the vision workers and observers: two
+/// observers started before the launch do not take a service's slot (the launch comes up), and
+/// when every slot is taken the refusal names the nodes that hold them.
+#[test]
+fn observers_of_the_camera_leave_the_services_their_slots_and_a_full_topic_names_its_holders() {
+    let (prefix, dir) = (common::unique_prefix("slots"), common::scratch("slots"));
+    let observe = || {
+        common::harvey(&["topic", "hz", "camera/frame", "--prefix", &prefix, "--wait-s", "60"])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::null())
+            .spawn()
+            .expect("observer")
+    };
+    let mut observers = vec![observe(), observe()];
+    let mut run =
+        common::harvey(&["run", "--realtime", "--prefix", &prefix, "--run-dir", dir.to_str().unwrap()])
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .expect("harvey run");
+    // Wait until the observers, the recorder and the vision workers are on the camera's topic.
+    let mut holders = |want: usize| {
+        let deadline = std::time::Instant::now() + Duration::from_secs(60);
+        loop {
+            let out =
+                common::harvey(&["topic", "list", "--prefix", &prefix, "--json"]).output().expect("list");
+            let nodes: Vec<String> = String::from_utf8_lossy(&out.stdout)
+                .lines()
+                .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+                .filter(|t| t["topic"] == "camera/frame")
+                .flat_map(|t| t["nodes"].as_array().cloned().unwrap_or_default())
+                .filter_map(|n| n.as_str().map(str::to_owned))
+                .collect();
+            let observing = nodes.iter().filter(|n| *n == "harvey-topic").count();
+            if observing == want
+                && nodes.iter().any(|n| n == "recorder")
+                && nodes.iter().any(|n| n == "vision-workers")
+            {
+                return nodes;
+            }
+            assert!(std::time::Instant::now() < deadline, "camera/frame held by {nodes:?}");
+            assert!(run.try_wait().expect("try_wait").is_none(), "the launch ended early");
+            std::thread::sleep(Duration::from_millis(100));
+        }
+    };
+    holders(2);
+    // Two more observers fill the six slots (recorder, vision workers, four observers)...
+    observers.push(observe());
+    observers.push(observe());
+    holders(4);
+    // ...and a fifth is refused, naming who holds them.
+    let full = common::harvey(&["topic", "echo", "camera/frame", "--prefix", &prefix, "--count", "1"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&full.stderr);
+    assert!(!full.status.success());
+    assert!(
+        err.contains("all 6 subscriber slots are taken")
+            && err.contains("recorder")
+            && err.contains("harvey-topic"),
+        "{err}"
+    );
+    for o in &mut observers {
+        common::signal(o, libc::SIGINT);
+        common::wait_exit(o, Duration::from_secs(10));
+    }
+    common::signal(&run, libc::SIGINT);
+    common::wait_exit(&mut run, Duration::from_secs(30));
+    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -182,7 +182,7 @@ impl Bus {
             .subscriber_builder()
             .buffer_size(topic.qos.buffer)
             .create()
-            .map_err(|e| BusError::topic(topic.name, "cannot create a frame subscriber", e))?;
+            .map_err(|e| BusError::subscriber(&self.prefix, topic.name, topic.qos.max_subscribers, e))?;
         let listener = event_ports(self, topic.name, topic.qos)?
             .listener_builder()
             .create()

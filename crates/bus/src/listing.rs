@@ -16,7 +16,7 @@ pub struct TopicInfo {
     pub name: String,
     /// The payload's type name as iceoryx2 records it (`harvey_msgs/SonarRing`, `[u8]` frames).
     pub type_name: String,
-    /// Names of the live nodes attached to it, sorted.
+    /// Names of the live nodes attached to it, sorted (a name twice: two nodes of that name).
     pub nodes: Vec<String>,
 }
 
@@ -36,7 +36,6 @@ pub fn topics(prefix: &str) -> Result<Vec<TopicInfo>> {
                 })
                 .collect();
             nodes.sort();
-            nodes.dedup();
             out.push(TopicInfo {
                 name: service.static_details.name().as_str().to_owned(),
                 type_name: ps.message_type_details().payload.type_name().to_string(),

@@ -117,7 +117,7 @@ impl<T: Message> Subscriber<T> {
             .subscriber_builder()
             .buffer_size(qos.buffer)
             .create()
-            .map_err(|e| BusError::topic(topic.name, "cannot create a subscriber", e))?;
+            .map_err(|e| BusError::subscriber(&bus.prefix, topic.name, qos.max_subscribers, e))?;
         let listener = event_ports(bus, topic.name, qos)?
             .listener_builder()
             .create()

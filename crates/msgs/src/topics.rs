@@ -29,11 +29,12 @@ impl Qos {
     /// expectations per map), and drops those its checkpoint says it has taken.
     pub const STATE: Qos =
         Qos { buffer: 16, borrowed: 2, history: 16, max_publishers: 4, max_subscribers: 8 };
-    /// Camera frames: every slot costs a whole frame of shared memory, so keep them few:
-    /// 3 subscribers x (2 queued + 1 held) + 1 loaned + 1 history = 11 frames (68 MB at 1080p
-    /// rgb8, 3.4 MB at 640x480 mono8). The history frame is what a restarted consumer is
-    /// handed again (the supervisor's re-offer, `harvey_bus` `reoffer.rs`).
-    pub const FRAMES: Qos = Qos { buffer: 2, borrowed: 1, history: 1, max_publishers: 1, max_subscribers: 3 };
+    /// Camera frames: every slot costs a whole frame of shared memory, so keep them few, yet
+    /// enough for the recorder, two vision workers and two observers (`harvey topic`, a Python
+    /// client) besides, one spare: 6 subscribers x (2 queued + 1 held) + 1 loaned + 1 history =
+    /// 20 frames (124 MB at 1080p rgb8, 6.1 MB at 640x480 mono8). The history frame is what a
+    /// restarted consumer is handed again (the supervisor's re-offer, `harvey_bus` `reoffer.rs`).
+    pub const FRAMES: Qos = Qos { buffer: 2, borrowed: 1, history: 1, max_publishers: 1, max_subscribers: 6 };
     /// Services' log lines (`rosout`): every service publishes on it, as ROS 2 nodes do.
     pub const LOG: Qos = Qos { buffer: 16, borrowed: 2, history: 16, max_publishers: 16, max_subscribers: 8 };
     /// A clock party's progress: read by its successor, the clock master and the supervisor
