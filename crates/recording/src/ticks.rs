@@ -191,6 +191,44 @@ mod tests {
     }
 
     #[test]
+    fn the_bridge_s_rosout_lines_are_inputs_and_other_services_lines_are_not() {
+        use harvey_msgs::{LogLevel, LogLine};
+        let dir = std::env::temp_dir().join(format!("harvey-ticks-{}-rosout", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("tmp");
+        let path = dir.join("t.mcap");
+        let mut r = Recorder::create(&path).expect("create");
+        let truth = r.channel::<TruePose>("sim/truth").expect("channel");
+        let rosout = r.channel::<LogLine>("rosout").expect("channel");
+        let line =
+            |seq, stamp, name| LogLine::new(Header::new(seq, stamp), LogLevel::Warn, name, "bad frame");
+        r.record(truth, &TruePose { header: Header::new(1, 1000), ..Default::default() }).expect("record");
+        r.record(rosout, &line(4, 1000, "denning-bridge")).expect("record");
+        r.record(rosout, &line(0, 1000, "ums")).expect("record");
+        // A line of another service at a stamp with no input does not make a tick of its own.
+        r.record(rosout, &line(1, 1500, "ums")).expect("record");
+        r.record(truth, &TruePose { header: Header::new(2, 2000), ..Default::default() }).expect("record");
+        r.finish().expect("finish");
+        let recording = Recording::open(&path).expect("read");
+        let mut seen = Vec::new();
+        let c = for_each_tick::<RecordingError>(&recording, |stamp, inputs| {
+            for i in inputs {
+                if let Input::Log(l) = i {
+                    seen.push((stamp, l.name().to_owned(), l.header.seq));
+                }
+            }
+            Ok(())
+        })
+        .expect("reads");
+        std::fs::remove_dir_all(&dir).ok();
+        assert_eq!(
+            seen,
+            [(1000, "denning-bridge".to_owned(), 4)],
+            "its number restored from the MCAP sequence"
+        );
+        assert_eq!((c.ticks, c.inputs), (2, 3));
+    }
+
+    #[test]
     fn an_input_stamped_before_the_last_is_an_error_naming_it() {
         let r = recording("back", &[(true, 1, 2000), (false, 1, 2000), (true, 2, 1000)]);
         let e = for_each_tick::<RecordingError>(&r, |_, _| Ok(())).expect_err("back in time");
