@@ -19,6 +19,8 @@ pub enum CdrError {
 #[derive(Debug, Default)]
 pub struct CdrWriter {
     buf: Vec<u8>,
+    /// The `frame_id` a message's headers carry: its type's [`Cdr::FRAME_ID`].
+    frame_id: &'static str,
 }
 
 impl CdrWriter {
@@ -26,7 +28,12 @@ impl CdrWriter {
     pub fn start(mut buf: Vec<u8>) -> Self {
         buf.clear();
         buf.extend_from_slice(&CDR_LE);
-        Self { buf }
+        Self { buf, frame_id: "" }
+    }
+
+    /// The frame the message being written is expressed in (`""` for a type without one).
+    pub fn frame_id(&self) -> &'static str {
+        self.frame_id
     }
 
     pub fn finish(self) -> Vec<u8> {
@@ -153,6 +160,8 @@ primitive!(u8, i8, u16, i16, i32, u32, u64, i64, f32, f64);
 
 /// A value with a CDR form.
 pub trait Cdr: Sized {
+    /// The coordinate frame (`frames.rs`) the headers of a message of this type name.
+    const FRAME_ID: &'static str = "";
     fn write(&self, w: &mut CdrWriter);
     fn read(r: &mut CdrReader<'_>) -> Result<Self, CdrError>;
 }
@@ -173,6 +182,7 @@ impl<T: Cdr + Copy + Default, const N: usize> Cdr for [T; N] {
 /// Encodes `v` as a complete CDR message into `buf` (reused).
 pub fn encode<T: Cdr>(v: &T, buf: Vec<u8>) -> Vec<u8> {
     let mut w = CdrWriter::start(buf);
+    w.frame_id = T::FRAME_ID;
     v.write(&mut w);
     w.finish()
 }

@@ -4,11 +4,16 @@
 
 mod codec;
 mod dynamic;
+pub mod frames;
+mod geometry;
 mod log;
+mod marker;
 mod schema;
 mod types;
 
 pub use codec::{Cdr, CdrError, CdrReader, CdrWriter, decode, encode};
 pub use dynamic::{Schema, SchemaError};
+pub use geometry::{Point, Quaternion, TfMessage, Transform};
+pub use marker::{Colour, Marker, MarkerArray, MarkerKind};
 pub use schema::{Def, full_text};
 pub use types::{Ros2Msg, decode_image, encode_image, image_def};

@@ -47,11 +47,12 @@ pub fn set_aside(path: &Path) -> Result<Option<PathBuf>, RecordingError> {
 }
 
 /// Writes the messages of `old` into `rec` (whose channels are set up), handing each to `each`
-/// as well (to draw it), then removes `old`.
+/// as well (topic, log time, sequence and bytes: to draw it, to derive from it), then removes
+/// `old`.
 pub fn carry_over<E: From<RecordingError>>(
     old: &Path,
     rec: &mut Recorder,
-    mut each: impl FnMut(&str, &[u8]) -> Result<(), E>,
+    mut each: impl FnMut(&str, u64, u32, &[u8]) -> Result<(), E>,
 ) -> Result<CarriedOver, E> {
     let recording = Recording::open(old)?;
     let bytes = recording.bytes();
@@ -69,7 +70,7 @@ pub fn carry_over<E: From<RecordingError>>(
                 continue;
             };
             rec.record_encoded(ch, u64::from(m.sequence), m.log_time, &m.data)?;
-            each(topic, &m.data)?;
+            each(topic, m.log_time, m.sequence, &m.data)?;
             out.messages += 1;
             let newest = out.newest.entry(topic.to_owned()).or_insert((m.log_time, m.sequence));
             *newest = (*newest).max((m.log_time, m.sequence));

@@ -23,6 +23,7 @@ mod chunk;
 pub mod compare;
 mod damage;
 pub mod data_files;
+pub mod derive;
 pub mod draw;
 mod error;
 pub mod export;

@@ -18,6 +18,11 @@ use crate::{
 
 /// QoS that ROS 2 tools expect on a channel: reliable, volatile, keep-last 16 (rosbag2's YAML).
 const QOS_YAML: &str = "- history: 1\n  depth: 16\n  reliability: 1\n  durability: 2\n  deadline:\n    sec: 2147483647\n    nsec: 4294967295\n  lifespan:\n    sec: 2147483647\n    nsec: 4294967295\n  liveliness: 1\n  liveliness_lease_duration:\n    sec: 2147483647\n    nsec: 4294967295\n  avoid_ros_namespace_conventions: false";
+/// The same, transient local (`durability: 1`): a late joiner gets the last message
+/// (`/tf_static`, the map).
+fn latched_qos() -> String {
+    QOS_YAML.replace("durability: 2", "durability: 1")
+}
 
 /// MCAP's chunk size: large enough to compress well, small enough to bound a crash's loss.
 const CHUNK_BYTES: u64 = 4 << 20;
@@ -101,11 +106,15 @@ impl Recorder {
     }
 
     fn add_channel(&mut self, topic: &str, def: &Def) -> Result<Channel, RecordingError> {
+        self.add_channel_qos(topic, def, QOS_YAML.to_owned())
+    }
+
+    fn add_channel_qos(&mut self, topic: &str, def: &Def, qos: String) -> Result<Channel, RecordingError> {
         let schema = self
             .writer
             .add_schema(&def.schema_name(), "ros2msg", full_text(def).as_bytes())
             .map_err(|e| self.err(e))?;
-        let metadata = BTreeMap::from([("offered_qos_profiles".to_owned(), QOS_YAML.to_owned())]);
+        let metadata = BTreeMap::from([("offered_qos_profiles".to_owned(), qos)]);
         let id = self
             .writer
             .add_channel(schema, &format!("/{topic}"), "cdr", &metadata)
@@ -118,6 +127,15 @@ impl Recorder {
     /// A channel for a topic of `T`.
     pub fn channel<T: Ros2Msg>(&mut self, topic: &str) -> Result<Channel, RecordingError> {
         self.add_channel(topic, T::DEF)
+    }
+
+    /// The channels of the derived topics (`derive::TOPICS`), in that order.
+    pub fn derived_channels(&mut self) -> Result<Vec<Channel>, RecordingError> {
+        let qos = |latched: bool| if latched { latched_qos() } else { QOS_YAML.to_owned() };
+        crate::derive::TOPICS
+            .iter()
+            .map(|&(topic, def, latched)| self.add_channel_qos(topic, def, qos(latched)))
+            .collect()
     }
 
     /// The channel set up for `topic`, if any.

@@ -13,6 +13,7 @@ use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waitable, Waiter};
 use harvey_cdr::Ros2Msg;
 use harvey_msgs::{Message, Topic, topics};
+use harvey_recording::derive::{self, Deriver};
 use harvey_recording::draw::draw_recorded;
 use harvey_recording::rrd::RrdWriter;
 use harvey_recording::{ChunkCompression, Recorder, carry_over, data_files};
@@ -182,15 +183,30 @@ fn main() -> anyhow::Result<()> {
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();
     let missing: Vec<&&str> = topics::ALL.iter().filter(|t| !recorded.contains(t)).collect();
     anyhow::ensure!(missing.is_empty(), "the recorder has no tap for {missing:?}");
+    let derived = rec.derived_channels()?;
+    let mut deriver = Deriver::new(world.as_ref());
     let mut recorded = std::collections::BTreeMap::new();
+    let mut to_derive = Vec::new();
     if let Some(old) = &interrupted {
-        let carried = carry_over::carry_over(old, &mut rec, |topic, data| -> anyhow::Result<()> {
-            if let Some(rrd) = rrd.as_mut() {
-                draw_recorded(rrd, topic, data).map_err(|e| anyhow::anyhow!("drawing {topic}: {e}"))?;
-            }
-            Ok(())
-        })?;
-        tracing::warn!(messages = carried.messages, damaged_chunks = ?carried.damaged_chunks, from = %old.display(), "continuing the recording a killed recorder left");
+        // The deriver goes through the carried-over messages as it went through them the first
+        // time; what it derives that the killed recorder had not written follows them.
+        let mut present = std::collections::BTreeSet::new();
+        let carried =
+            carry_over::carry_over(old, &mut rec, |topic, log_time, seq, data| -> anyhow::Result<()> {
+                if derive::is_derived(topic) {
+                    present.insert((topic.to_owned(), log_time, seq));
+                    return Ok(());
+                }
+                deriver
+                    .derive(topic, log_time, data, &mut to_derive)
+                    .map_err(|e| anyhow::anyhow!("deriving from {topic}: {e}"))?;
+                if let Some(rrd) = rrd.as_mut() {
+                    draw_recorded(rrd, topic, data).map_err(|e| anyhow::anyhow!("drawing {topic}: {e}"))?;
+                }
+                Ok(())
+            })?;
+        to_derive = derive::missing(to_derive, &present);
+        tracing::warn!(messages = carried.messages, derived_again = to_derive.len(), damaged_chunks = ?carried.damaged_chunks, from = %old.display(), "continuing the recording a killed recorder left");
         recorded = carried.newest;
     }
     if let Some(c) = checkpoint.as_mut() {
@@ -203,7 +219,9 @@ fn main() -> anyhow::Result<()> {
     let _attached = pace.attach(&waiter, &waitables)?;
     let flush_every = Duration::from_millis(args.flush_ms.max(1));
     let quarter_flush_ns = args.flush_ms.max(1) * 250_000;
-    let writer = Writer::start(Files { mcap: rec, rrd }, flush_every)?;
+    let mut files = Files { mcap: rec, rrd, deriver, derived };
+    files.record_derived(to_derive)?;
+    let writer = Writer::start(files, flush_every)?;
     harvey_runtime::notify_ready()?;
     tracing::info!(output = %args.output.display(), topics = taps.len(), lockstep, "recording");
 

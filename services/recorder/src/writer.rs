@@ -1,14 +1,16 @@
-//! The recorder's writer thread: compresses and writes batches to the MCAP file and draws them
-//! into the Rerun file, off the bus thread, so that a party of the clock chain is done with a
+//! The recorder's writer thread: compresses and writes batches to the MCAP file (with the topics
+//! derived from them, `harvey_recording::derive`) and draws them into the Rerun file, off the bus
+//! thread, so that a party of the clock chain is done with a
 //! tick as soon as it has taken the tick's messages out of shared memory.
 
 use std::sync::mpsc::{Receiver, RecvTimeoutError, Sender, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use harvey_recording::derive::{self, Derived, Deriver};
 use harvey_recording::draw::draw_recorded;
 use harvey_recording::rrd::RrdWriter;
-use harvey_recording::{ChannelStats, Recorder};
+use harvey_recording::{Channel, ChannelStats, Recorder};
 
 use crate::taps::Batch;
 
@@ -20,6 +22,21 @@ const QUEUE: usize = 8;
 pub struct Files {
     pub mcap: Recorder,
     pub rrd: Option<RrdWriter>,
+    pub deriver: Deriver,
+    /// The derived topics' channels, in `derive::TOPICS`' order.
+    pub derived: Vec<Channel>,
+}
+
+impl Files {
+    /// Records derived messages on their channels.
+    pub fn record_derived(&mut self, messages: impl IntoIterator<Item = Derived>) -> anyhow::Result<()> {
+        for d in messages {
+            let ch = derive::index(d.topic).and_then(|k| self.derived.get(k).copied());
+            let ch = ch.ok_or_else(|| anyhow::anyhow!("no channel for the derived topic {}", d.topic))?;
+            self.mcap.record_encoded(ch, d.seq, d.stamp_ns, &d.data)?;
+        }
+        Ok(())
+    }
 }
 
 /// The bus thread's handle on the writer thread.
@@ -73,12 +90,18 @@ fn write_loop(
     // batch over (a quarter), a SIGKILL loses less than the interval.
     let flush_ns = u64::try_from(flush_every.as_nanos() / 2).unwrap_or(u64::MAX);
     let (mut flushed_ns, mut newest_ns) = (0u64, 0u64);
+    let mut derived = Vec::new();
     loop {
         match batches.recv_timeout(flush_every) {
             Ok(batch) => {
                 newest_ns = batch.items.iter().map(|i| i.stamp_ns).fold(newest_ns, u64::max);
                 for i in &batch.items {
                     files.mcap.record_encoded(i.channel, i.seq, i.stamp_ns, &i.data)?;
+                    files
+                        .deriver
+                        .derive(i.topic, i.stamp_ns, &i.data, &mut derived)
+                        .map_err(|e| anyhow::anyhow!("deriving from {}: {e}", i.topic))?;
+                    files.record_derived(derived.drain(..))?;
                     if let Some(rrd) = files.rrd.as_mut() {
                         draw_recorded(rrd, i.topic, &i.data)
                             .map_err(|e| anyhow::anyhow!("drawing {}: {e}", i.topic))?;
