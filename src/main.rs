@@ -125,6 +125,7 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             prefix: harvey_bus::DEFAULT_PREFIX.into(),
             realtime: false,
             live: None,
+            foxglove: None,
         },
     });
     match cmd {

@@ -1,8 +1,9 @@
 //! The conventions the build enforces: every Rust file opens with a `//!` line saying what it
 //! is; only `crates/bus` uses iceoryx2 (the zero-copy marker aside); only the recording crate
-//! and the recorder draw with rerun; no service crate depends on another service crate and no
-//! `crates/*` on a `services/*`, read from `cargo metadata`. Each rule is a function over plain
-//! data, tested on a deliberate violation as well as on the workspace itself.
+//! and the recorder draw with rerun; only the Foxglove bridge serves with foxglove; no service
+//! crate depends on another service crate and no `crates/*` on a `services/*`, read from
+//! `cargo metadata`. Each rule is a function over plain data, tested on a deliberate violation
+//! as well as on the workspace itself.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use std::path::{Path, PathBuf};
@@ -92,7 +93,8 @@ fn dependency_violations(packages: &[Package]) -> Vec<String> {
 }
 
 /// Which packages may name a dependency: iceoryx2 only in the bus (its marker trait and derive
-/// also in the wire types and the pose they carry), rerun only where runs are drawn.
+/// also in the wire types and the pose they carry), rerun only where runs are drawn, foxglove
+/// (a WebSocket server) only in the Foxglove bridge.
 fn confinement_violations(packages: &[Package]) -> Vec<String> {
     let allowed = |dep: &str| -> Option<&'static [&'static str]> {
         match dep {
@@ -101,6 +103,7 @@ fn confinement_violations(packages: &[Package]) -> Vec<String> {
                 Some(&["crates/bus", "crates/msgs", "crates/geometry"])
             }
             "rerun" => Some(&["crates/recording", "services/recorder"]),
+            "foxglove" => Some(&["services/foxglove-bridge"]),
             _ => None,
         }
     };
@@ -192,13 +195,14 @@ fn each_rule_catches_a_deliberate_violation() {
     let cli = packages.iter_mut().find(|p| p.dir.is_empty()).expect("the CLI");
     cli.deps.push(dep("harvey-recorder", "services/recorder", false));
     cli.deps.push(Dep { name: "rerun".into(), dir: None, dev: false });
+    cli.deps.push(Dep { name: "foxglove".into(), dir: None, dev: false });
     let v = dependency_violations(&packages);
     assert_eq!(v.len(), 3, "{v:#?}");
     assert!(v.iter().any(|m| m.starts_with("service harvey-ums") && m.contains("harvey-sim-drv")), "{v:#?}");
     assert!(v.iter().any(|m| m.contains("crate harvey-vision") && m.contains("harvey-camera")), "{v:#?}");
     assert!(v.iter().any(|m| m.contains("the CLI") && m.contains("harvey-recorder")), "{v:#?}");
     let c = confinement_violations(&packages);
-    assert!(c.len() == 1 && c[0].contains("rerun"), "{c:#?}");
+    assert!(c.len() == 2 && c[0].contains("rerun") && c[1].contains("foxglove"), "{c:#?}");
     assert!(header_violation("x.rs", "use std::fs;\n").is_some());
     assert!(header_violation("x.rs", "//! What x is.\nuse std::fs;\n").is_none());
     let direct = ["let n = iceoryx2", "::node::NodeBuilder::new();\n"].concat();

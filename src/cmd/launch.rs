@@ -21,6 +21,10 @@ pub fn supervise(file: &Path, args: &LaunchArgs) -> anyhow::Result<i32> {
     if args.realtime {
         lf.settings.clock = harvey_supervisor::ClockMode::Realtime;
     }
+    if let Some(addr) = &args.foxglove {
+        // First: it is listening before anything publishes, and is stopped last.
+        lf.services.insert(0, super::live::foxglove_service(addr, lf.settings.world.is_some())?);
+    }
     let outcome = harvey_supervisor::run(&lf, &launch_options(&lf, args), &mut line)?;
     line.report(&outcome)?;
     Ok(outcome.exit_code())

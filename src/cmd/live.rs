@@ -1,7 +1,8 @@
 //! `--live`: where the recorder streams its Rerun drawing, and a viewer started there when the
-//! user named none and none answers at Rerun's default address.
+//! user named none and none answers at Rerun's default address. `--foxglove`: the Foxglove
+//! bridge added to a launch as one more service.
 
-use std::net::{SocketAddr, TcpStream};
+use std::net::{SocketAddr, TcpListener, TcpStream, ToSocketAddrs};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -62,4 +63,47 @@ pub fn viewer(url: &str) -> anyhow::Result<String> {
         std::thread::sleep(Duration::from_millis(100));
     }
     Ok(url)
+}
+
+/// The Foxglove bridge's service name (its binary: `harvey-foxglove-bridge`, beside `harvey`).
+pub const FOXGLOVE_SERVICE: &str = "foxglove-bridge";
+/// Where `--foxglove` without an address serves: Foxglove's default.
+pub const FOXGLOVE_DEFAULT: &str = "127.0.0.1:8765";
+
+/// Checks `--foxglove ADDR` before anything starts: a HOST:PORT that can be listened on now.
+pub fn foxglove_addr(addr: &str) -> anyhow::Result<SocketAddr> {
+    let at = addr.to_socket_addrs().ok().and_then(|mut a| a.next()).ok_or_else(|| {
+        anyhow::anyhow!("--foxglove {addr}: an address reads HOST:PORT (e.g. {FOXGLOVE_DEFAULT})")
+    })?;
+    TcpListener::bind(at).map_err(|e| anyhow::anyhow!("--foxglove {addr}: cannot listen there: {e}"))?;
+    Ok(at)
+}
+
+/// The `[[service]]` `--foxglove ADDR` adds to a launch: the bridge, serving at `addr`, watching
+/// the bus without a turn in the clock chain.
+pub fn foxglove_service(addr: &str, with_world: bool) -> anyhow::Result<harvey_supervisor::config::Service> {
+    let world = if with_world { ", \"--world\", \"${world}\"" } else { "" };
+    let text = format!(
+        "name = \"{FOXGLOVE_SERVICE}\"\nargs = [\"--listen\", {}{world}]\nclock_party = false\n",
+        toml::Value::String(addr.to_owned())
+    );
+    Ok(toml::from_str(&text)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_foxglove_service_is_the_bridge_off_the_clock_chain() {
+        let s = foxglove_service("127.0.0.1:9\"x", false).expect("service");
+        assert_eq!((s.name(), s.binary_name().as_str()), ("foxglove-bridge", "harvey-foxglove-bridge"));
+        assert_eq!(s.args, ["--listen", "127.0.0.1:9\"x"]);
+        let with_world = foxglove_service("127.0.0.1:9", true).expect("service");
+        assert_eq!(with_world.args, ["--listen", "127.0.0.1:9", "--world", "${world}"]);
+        assert!(!s.clock_party);
+        assert!(foxglove_addr("127.0.0.1:0").is_ok());
+        let e = foxglove_addr("nowhere").expect_err("no port").to_string();
+        assert!(e.contains("HOST:PORT"), "{e}");
+    }
 }

@@ -34,6 +34,11 @@ pub struct LaunchArgs {
     /// started (`rerun` on the PATH or in `.venv`) if none answers there. The MCAP is unchanged.
     #[arg(long, num_args = 0..=1, default_missing_value = "", value_name = "URL")]
     pub live: Option<String>,
+    /// Also serve every topic live to Foxglove (`docs/foxglove.md`): the Foxglove bridge runs as
+    /// one more service, a Foxglove WebSocket server at ADDR (HOST:PORT; without one,
+    /// 127.0.0.1:8765). Give it as `--foxglove=ADDR` before a mission's path.
+    #[arg(long, num_args = 0..=1, default_missing_value = live::FOXGLOVE_DEFAULT, value_name = "ADDR")]
+    pub foxglove: Option<String>,
 }
 
 /// Where launch file `lf` runs, given `args`.
@@ -56,6 +61,12 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
         // recorder, a child of this keeper process, reads the variable.
         unsafe { std::env::set_var(live::LIVE_ENV, &url) };
     }
+    if let Some(addr) = &args.foxglove {
+        let at = live::foxglove_addr(addr)?;
+        let url =
+            if at.port() == 0 { format!("ws://{}:<a free port>", at.ip()) } else { format!("ws://{at}") };
+        println!("foxglove: serving at {url} (Foxglove: Open connection, Foxglove WebSocket)");
+    }
     tracing::info!(launch = %lf.settings.name, run_dir = %opts.run_dir.display(), prefix = %opts.prefix, "launching {} services", lf.services.len());
     let exe = std::env::current_exe()?;
     let make = || {
@@ -63,6 +74,9 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
         cmd.arg("supervise").arg(file).arg("--run-dir").arg(&opts.run_dir).args(["--prefix", &opts.prefix]);
         if args.realtime {
             cmd.arg("--realtime");
+        }
+        if let Some(addr) = &args.foxglove {
+            cmd.arg(format!("--foxglove={addr}"));
         }
         cmd
     };

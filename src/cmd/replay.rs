@@ -86,6 +86,7 @@ mod tests {
             prefix: "bad prefix".into(),
             realtime: false,
             live: None,
+            foxglove: None,
         };
         assert!(run(&recording, false, false, false, opts).is_err(), "a bad prefix is refused");
         assert!(!dir.join("other").exists(), "before anything is written");
