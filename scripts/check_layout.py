@@ -42,6 +42,8 @@ def main() -> int:
             need(topic, panel=panel)
         if image := config.get("imageMode", {}).get("imageTopic"):
             need(image, "sensor_msgs/msg/Image", panel)
+        if calibration := config.get("imageMode", {}).get("calibrationTopic"):
+            need(calibration, "sensor_msgs/msg/CameraInfo", panel)
         if kind == "RosOut":
             need(config["topicToRender"], "rcl_interfaces/msg/Log", panel)
         if follow := config.get("followTf"):

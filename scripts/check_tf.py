@@ -15,6 +15,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 # The standard messages a Harvey recording carries, which must be Jazzy's to the field.
 STANDARD = [
     "sensor_msgs/msg/Image",
+    "sensor_msgs/msg/CameraInfo",
     "rcl_interfaces/msg/Log",
     "tf2_msgs/msg/TFMessage",
     "visualization_msgs/msg/MarkerArray",

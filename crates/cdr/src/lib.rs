@@ -2,6 +2,7 @@
 //! Harvey's messages, so that ROS 2 tools, Foxglove and the Python `mcap-ros2-support` decoder
 //! read Harvey's recordings without Harvey's code. Decoding serves replay and `harvey info`.
 
+mod camera_info;
 mod codec;
 mod dynamic;
 pub mod frames;
@@ -11,6 +12,7 @@ mod marker;
 mod schema;
 mod types;
 
+pub use camera_info::CameraInfo;
 pub use codec::{Cdr, CdrError, CdrReader, CdrWriter, decode, encode};
 pub use dynamic::{Schema, SchemaError};
 pub use geometry::{Point, Quaternion, TfMessage, Transform};

@@ -4,9 +4,12 @@
 //! message follows the message it comes from, with its stamp, so a deterministic run (and its
 //! replay) derives the same bytes; the recorder writes them and the Foxglove bridge serves them.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 
-use harvey_cdr::{CdrError, Def, MarkerArray, Ros2Msg, TfMessage, Transform, decode, encode, frames};
+use harvey_cdr::{
+    CameraInfo, CdrError, Def, MarkerArray, Ros2Msg, TfMessage, Transform, decode, decode_image, encode,
+    frames,
+};
 use harvey_msgs::{MissionStatus, Odometry, PlanSketch, Pose2, TruePose, UncertaintyMap, topics};
 use harvey_world::World;
 
@@ -14,18 +17,21 @@ mod markers;
 
 /// The derived topics (without the leading `/`), their types, and whether a late joiner must
 /// still get their last message (`/tf_static`, the map: ROS's transient-local durability).
-pub const TOPICS: [(&str, &Def, bool); 5] = [
+pub const TOPICS: [(&str, &Def, bool); 6] = [
     (TF, <TfMessage as Ros2Msg>::DEF, false),
     (TF_STATIC, <TfMessage as Ros2Msg>::DEF, true),
     (MAP_MARKERS, <MarkerArray as Ros2Msg>::DEF, true),
     (UNCERTAINTY_MARKERS, <MarkerArray as Ros2Msg>::DEF, false),
     (PLAN_MARKERS, <MarkerArray as Ros2Msg>::DEF, false),
+    (CAMERA_INFO, <CameraInfo as Ros2Msg>::DEF, false),
 ];
 pub const TF: &str = "tf";
 pub const TF_STATIC: &str = "tf_static";
 pub const MAP_MARKERS: &str = "markers/map";
 pub const UNCERTAINTY_MARKERS: &str = "markers/uncertainty";
 pub const PLAN_MARKERS: &str = "markers/plan";
+/// Each camera frame's calibration (with the run's world): Foxglove places the image in 3D by it.
+pub const CAMERA_INFO: &str = "camera/camera_info";
 
 /// Where `topic` (with or without its leading `/`) is in [`TOPICS`].
 pub fn index(topic: &str) -> Option<usize> {
@@ -55,17 +61,24 @@ const OPTICAL_FROM_BASE: [f64; 4] = [-0.5, 0.5, -0.5, 0.5];
 pub struct Deriver {
     world: Option<World>,
     started: bool,
-    /// The newest odometry pose (the robot in `odom`) and its stamp. Each derived message
-    /// depends on its source alone, or on the source's tick: a recording that lost some messages
-    /// lacks what they bring, and holds nothing that differs.
-    odometry: Option<(u64, Pose2)>,
+    /// Recent odometry poses and executive estimates by stamp, each waiting for the other of its
+    /// tick. Each derived message depends on its source alone, or on its source's tick: a
+    /// recording that lost some messages lacks what they bring, and holds nothing that differs.
+    odometry: BTreeMap<u64, Pose2>,
+    estimates: BTreeMap<u64, Pose2>,
     seq: [u64; TOPICS.len()],
 }
 
 impl Deriver {
     /// With the run's world, the map's markers and the camera's height; without, neither.
     pub fn new(world: Option<&World>) -> Self {
-        Self { world: world.cloned(), started: false, odometry: None, seq: [0; 5] }
+        Self {
+            world: world.cloned(),
+            started: false,
+            odometry: BTreeMap::new(),
+            estimates: BTreeMap::new(),
+            seq: [0; TOPICS.len()],
+        }
     }
 
     fn push(&mut self, topic: &'static str, stamp_ns: u64, data: Vec<u8>, out: &mut Vec<Derived>) {
@@ -102,19 +115,31 @@ impl Deriver {
             }
             _ if t == topics::ODOMETRY.name => {
                 let p = decode::<Odometry>(data)?.world_from_robot;
-                self.odometry = Some((stamp_ns, p));
                 self.tf(stamp_ns, vec![planar(stamp_ns, frames::ODOM, frames::BASE_LINK, &p)], out);
+                self.pair(stamp_ns, Some(p), None, out);
             }
             _ if t == topics::EXECUTIVE_STATUS.name => {
-                // Only with the odometry of the same tick: a recording that lost it (a killed
-                // recorder's unflushed tail) lacks this transform rather than holding another.
-                let Some((_, o)) = self.odometry.filter(|(at, _)| *at == stamp_ns) else { return Ok(()) };
-                let c = correction(&decode::<MissionStatus>(data)?.estimated, &o);
-                self.tf(stamp_ns, vec![Transform::planar(stamp_ns, frames::WORLD, frames::ODOM, c)], out);
+                let estimate = decode::<MissionStatus>(data)?.estimated;
+                self.pair(stamp_ns, None, Some(estimate), out);
             }
             _ if t == topics::UMS_MAP.name => {
                 let m = markers::uncertainty(stamp_ns, &decode::<UncertaintyMap>(data)?);
                 self.push(UNCERTAINTY_MARKERS, stamp_ns, encode(&m, Vec::new()), out);
+            }
+            _ if t == topics::CAMERA_FRAME.name => {
+                let Some(world) = &self.world else { return Ok(()) };
+                let (h, _) = decode_image(data)?;
+                let (w, ht) = (h.width_px, h.height_px);
+                // Harvey's pixel (u, v) covers [u, u + 1); ROS puts its centre at (u, v).
+                let info = CameraInfo {
+                    stamp_ns: h.stamp_ns,
+                    frame_id: frames::CAMERA.into(),
+                    width_px: w,
+                    height_px: ht,
+                    focal_px: world.camera.focal_for(w),
+                    centre_px: [f64::from(w) / 2.0 - 0.5, f64::from(ht) / 2.0 - 0.5],
+                };
+                self.push(CAMERA_INFO, stamp_ns, encode(&info, Vec::new()), out);
             }
             _ if t == topics::EXECUTIVE_PLAN.name => {
                 let m = markers::plan(stamp_ns, &decode::<PlanSketch>(data)?);
@@ -123,6 +148,31 @@ impl Deriver {
             _ => {}
         }
         Ok(())
+    }
+
+    /// `world → odom` once a tick's odometry and estimate are both in, whichever came first (a
+    /// live observer may take them in either order).
+    fn pair(
+        &mut self,
+        stamp_ns: u64,
+        odometry: Option<Pose2>,
+        estimate: Option<Pose2>,
+        out: &mut Vec<Derived>,
+    ) {
+        let (o, e) = match (odometry, estimate) {
+            (Some(o), _) => (Some(o), self.estimates.remove(&stamp_ns)),
+            (None, Some(e)) => (self.odometry.remove(&stamp_ns), Some(e)),
+            (None, None) => (None, None),
+        };
+        match (o, e) {
+            (Some(o), Some(e)) => {
+                let c = correction(&e, &o);
+                self.tf(stamp_ns, vec![Transform::planar(stamp_ns, frames::WORLD, frames::ODOM, c)], out);
+            }
+            (Some(o), None) => keep_recent(&mut self.odometry, stamp_ns, o),
+            (None, Some(e)) => keep_recent(&mut self.estimates, stamp_ns, e),
+            (None, None) => {}
+        }
     }
 
     /// `/tf_static` (the camera on the robot) and, with the world, the map and the robot at its start.
@@ -145,6 +195,17 @@ impl Deriver {
         let world_odom = Transform::planar(0, frames::WORLD, frames::ODOM, [0.0; 3]);
         self.push(MAP_MARKERS, stamp_ns, encode(&map, Vec::new()), out);
         self.tf(stamp_ns, vec![world_odom, start], out);
+    }
+}
+
+/// Ticks a half of a pair waits for the other: a live observer takes a topic's queue whole, so
+/// the other half comes within a queue's worth of ticks or not at all.
+const PAIR_WAIT: usize = 64;
+
+fn keep_recent(waiting: &mut BTreeMap<u64, Pose2>, stamp_ns: u64, p: Pose2) {
+    waiting.insert(stamp_ns, p);
+    while waiting.len() > PAIR_WAIT {
+        waiting.pop_first();
     }
 }
 

@@ -72,8 +72,9 @@ struct Recorded {
 }
 
 /// The bus topics the derived ones come from.
-const SOURCES: [&str; 5] = [
+const SOURCES: [&str; 6] = [
     topics::SIM_TRUTH.name,
+    topics::CAMERA_FRAME.name,
     topics::ODOMETRY.name,
     topics::EXECUTIVE_STATUS.name,
     topics::UMS_MAP.name,

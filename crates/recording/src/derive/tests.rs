@@ -79,6 +79,13 @@ fn world_to_odom_to_base_link_puts_the_robot_at_its_estimate() {
     out.clear();
     d.derive(topics::EXECUTIVE_STATUS.name, 20, &status(20, est), &mut out).expect("status");
     assert!(out.is_empty(), "{out:?}");
+    // Taken the other way round (a live observer), the pair brings the same transform.
+    let mut e = Deriver::new(None);
+    let mut other = Vec::new();
+    e.derive(topics::EXECUTIVE_STATUS.name, 10, &status(10, est), &mut other).expect("status");
+    e.derive(topics::ODOMETRY.name, 10, &odometry(10, odo), &mut other).expect("odometry");
+    let world_odom_again = other.iter().rev().find(|m| m.topic == TF).expect("tf");
+    assert_eq!(decode::<TfMessage>(&world_odom_again.data).expect("tf").0.remove(0), world_odom);
 }
 
 #[test]
@@ -108,4 +115,32 @@ fn a_continued_recording_gets_only_the_derived_messages_it_lacks() {
         derived[..3].iter().map(|m| (m.topic.to_owned(), m.stamp_ns, m.seq as u32)).collect();
     let lacking = missing(derived.clone(), &present);
     assert_eq!(lacking, derived[3..].to_vec());
+}
+
+#[test]
+fn each_frame_brings_its_calibration_with_the_world_and_none_without() {
+    let world = world();
+    let h = harvey_msgs::FrameHeader {
+        seq: 3,
+        stamp_ns: 7,
+        width_px: 320,
+        height_px: 240,
+        stride_bytes: 320,
+        encoding: harvey_msgs::Encoding::Mono8 as u32,
+    };
+    let frame = harvey_cdr::encode_image(&h, &vec![0u8; 320 * 240], Vec::new());
+    let mut out = Vec::new();
+    Deriver::new(None).derive(topics::CAMERA_FRAME.name, 7, &frame, &mut out).expect("derives");
+    assert!(out.iter().all(|m| m.topic != CAMERA_INFO), "no calibration without the world");
+    out.clear();
+    let mut d = Deriver::new(Some(&world));
+    d.derive(topics::CAMERA_FRAME.name, 7, &frame, &mut out).expect("derives");
+    let info = out.iter().find(|m| m.topic == CAMERA_INFO).expect("a calibration");
+    let info = decode::<harvey_cdr::CameraInfo>(&info.data).expect("camera info");
+    assert_eq!(
+        (info.width_px, info.height_px, info.stamp_ns, info.frame_id.as_str()),
+        (320, 240, 7, frames::CAMERA)
+    );
+    assert_eq!(info.focal_px, world.camera.focal_for(320), "the focal length scales with the frame");
+    assert_eq!(info.centre_px, [159.5, 119.5]);
 }
