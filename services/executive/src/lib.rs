@@ -128,8 +128,10 @@ impl Executive {
         self.maps_seen += 1;
         let became_lost = m.lost != 0 && !self.lost;
         self.lost = m.lost != 0;
-        if let (true, Mode::Plan(plan)) = (became_lost, &mut self.mode) {
-            plan.lost();
+        match &mut self.mode {
+            Mode::Plan(plan) if became_lost => plan.lost(),
+            Mode::Sequenced(run) => run.behaviour.on_map(m),
+            _ => {}
         }
     }
 

@@ -2,8 +2,8 @@
 //! docking and the pole hunt, behind one face, and run as the executive's mode.
 
 use harvey_msgs::{
-    BehaviourState, MissionState, MotionCommand, Odometry, Pose2, ServoLevel, SonarRing, VisionRequest,
-    VisionResult,
+    BehaviourState, MissionState, MotionCommand, Odometry, Pose2, ServoLevel, SonarRing, UncertaintyMap,
+    VisionRequest, VisionResult,
 };
 
 use super::docking::Docking;
@@ -21,6 +21,13 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.on_sonar(r),
             Self::Poles(p) => p.on_sonar(r),
+        }
+    }
+
+    /// The UMS's newest map: docking judges its first pose fix by it.
+    pub fn on_map(&mut self, m: &UncertaintyMap) {
+        if let Self::Docking(d) = self {
+            d.on_map(m);
         }
     }
 

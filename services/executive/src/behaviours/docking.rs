@@ -9,13 +9,14 @@
 
 use harvey_geometry::wrap;
 use harvey_msgs::{
-    BehaviourState, MotionCommand, Pose2, SonarRing, VisionAlgorithm, VisionRequest, VisionResult,
-    VisionStatus,
+    BehaviourState, MotionCommand, Pose2, SonarRing, UncertaintyMap, VisionAlgorithm, VisionRequest,
+    VisionResult, VisionStatus,
 };
 
 use super::dock_pose::{face_distance, pose_from_dock};
 use super::drive::{self, DriveParams, Vectors};
 use super::fsa::{Fsa, Trigger};
+use super::region::Region;
 use super::schemas::{Noise, V2, move_to_goal};
 use super::sequenced::Sequenced;
 use crate::mission::DockingGoal;
@@ -44,6 +45,8 @@ pub struct Docking {
     pub done: Option<bool>,
     /// Odometry now, and the last fix from the dock.
     belief: Belief,
+    /// Where the UMS last said the robot can be: the gate on the first fix.
+    region: Option<Region>,
     /// The believed heading when the target was last seen, and ticks since the last fix asked.
     target_heading: f64,
     since_fix: u32,
@@ -76,6 +79,7 @@ impl Docking {
             retreating: false,
             done: None,
             belief: Belief::default(),
+            region: None,
             target_heading: 0.0,
             since_fix: 0,
         }
@@ -111,6 +115,10 @@ impl Docking {
         self.ring = Some(*r);
     }
 
+    pub fn on_map(&mut self, m: &UncertaintyMap) {
+        self.region = Region::of(m);
+    }
+
     /// The answer to the request awaited: the perceptual trigger of the state it was asked in.
     pub fn on_vision(&mut self, r: &VisionResult) {
         if !self.seq.answers(r) {
@@ -120,11 +128,16 @@ impl Docking {
         let found = VisionStatus::from_raw(r.status) == Some(VisionStatus::Found) && r.count > 0;
         let item = found.then(|| r.items[0].values.map(f64::from));
         let dock = r.algorithm == VisionAlgorithm::Dock as u32;
-        // A fix far from the belief is a misreading, once the belief has had a first fix.
-        let near = |p: &Pose2| {
-            !self.belief.has_fix()
-                || ((p.x_m - at.x_m).hypot(p.y_m - at.y_m) < self.g.fix_gate_m
-                    && wrap(p.heading_rad - at.heading_rad).abs() < self.g.fix_gate_deg.to_radians())
+        // A fix far from the belief is a misreading, once the belief has had a first fix; the
+        // first, one outside the UMS's region by more than a fix's own error.
+        let (gate_m, gate_rad) = (self.g.fix_gate_m, self.g.fix_gate_deg.to_radians());
+        let near = |p: &Pose2| match &self.region {
+            _ if self.belief.has_fix() => {
+                (p.x_m - at.x_m).hypot(p.y_m - at.y_m) < gate_m
+                    && wrap(p.heading_rad - at.heading_rad).abs() < gate_rad
+            }
+            Some(region) => region.admits(p, gate_m, gate_rad),
+            None => true,
         };
         if let (true, Some(v)) = (dock, &item)
             && let Some(p) = pose_from_dock(&self.g, self.focal_px, self.centre_px[0], v).filter(near)

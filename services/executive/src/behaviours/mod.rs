@@ -1,7 +1,8 @@
 //! The acceptor-sequenced behaviours a mission may run instead of a script or a plan (004): a
 //! finite state acceptor (`fsa.rs`, its bookkeeping in `sequenced.rs`) picks each tick's
 //! perceptual algorithm, and motor schemas (`schemas.rs`, on the robot in `drive.rs`) drive.
-//! Docking (`docking.rs`, the pose from the dock in `dock_pose.rs`) and the pole hunt
+//! Docking (`docking.rs`, the pose from the dock in `dock_pose.rs`, judged by the UMS's region in
+//! `region.rs`) and the pole hunt
 //! (`pole_hunt.rs`) behind one face (`behaviour.rs`).
 
 pub mod behaviour;
@@ -10,6 +11,7 @@ pub mod docking;
 pub mod drive;
 pub mod fsa;
 pub mod pole_hunt;
+pub mod region;
 pub mod schemas;
 pub mod sequenced;
 
