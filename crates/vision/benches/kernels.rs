@@ -79,7 +79,8 @@ impl Row {
 /// The path a kernel runs: the dispatched one for correlation, Moravec and what is built on
 /// them; the rest have no hand-written SIMD and run the build's baseline code.
 fn path_of(kernel: &str) -> String {
-    let dispatched = ["normalised correlation", "Moravec", "coarse-to-fine", "stereo", "depth from motion"];
+    let dispatched =
+        ["normalised correlation", "Moravec", "coarse-to-fine", "stereo", "depth from motion", "activity"];
     if dispatched.iter().any(|k| kernel.starts_with(k)) {
         SimdPath::active().name().to_owned()
     } else {

@@ -1,11 +1,10 @@
 //! The long-range cues of 004 §4.1 that bring the robot towards a dock: phototropic perception
 //! (the brightest region) and activity detection (where successive frames differ, in both
-//! variants). The dock itself is recognised by `hough`.
+//! variants, `activity.rs`). The dock itself is recognised by `hough`.
 
-use std::collections::VecDeque;
-
+pub use crate::activity::{Activity, ActivityDetector, ActivityVote};
 use crate::frs::{ClassRange, Frs, Region};
-use crate::image::{Gray, GrayBuf, Rect, VisionError};
+use crate::image::{Gray, Rect, VisionError};
 
 /// Phototropic perception: the largest region within `margin` grey levels of the brightest
 /// pixel of `window` (a lamp, a beacon), of at least `min_area` pixels.
@@ -23,107 +22,10 @@ pub fn brightest(
     Ok(frs.segment(img, w, &ranges, min_area)?.first().copied())
 }
 
-/// How differences count in the motion plane (004 §4.1: "two variations").
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ActivityVote {
-    /// The absolute intensity difference.
-    Difference,
-    /// One vote for each difference over this threshold, whatever the contrast.
-    Threshold(u8),
-}
-
-/// Where the motion is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Activity {
-    /// Activity-weighted centroid of the window's motion plane.
-    pub centroid: [f32; 2],
-    /// Mean activity per pixel per frame pair.
-    pub strength: f32,
-}
-
-/// Activity detection over the last `depth` frames of one window.
-#[derive(Debug)]
-pub struct ActivityDetector {
-    pub vote: ActivityVote,
-    depth: usize,
-    frames: VecDeque<GrayBuf>,
-    spare: Vec<GrayBuf>,
-    plane: Vec<u32>,
-}
-
-impl ActivityDetector {
-    pub fn new(vote: ActivityVote, depth: usize) -> Self {
-        Self { vote, depth: depth.max(2), frames: VecDeque::new(), spare: Vec::new(), plane: Vec::new() }
-    }
-
-    /// Adds a frame's `window` (the same size every time) and returns the activity over the frames
-    /// kept, once there are two.
-    pub fn push(&mut self, img: &Gray<'_>, window: Rect) -> Result<Option<Activity>, VisionError> {
-        let w = window.inside(img.width, img.height)?;
-        if self.frames.front().is_some_and(|f| (f.width, f.height) != (w.width(), w.height())) {
-            return Err(VisionError::BadParameter(format!("window {w} changed size between frames")));
-        }
-        let mut buf = self.spare.pop().unwrap_or_default();
-        (buf.width, buf.height) = (w.width(), w.height());
-        buf.data.clear();
-        for y in w.y0..w.y1 {
-            buf.data.extend_from_slice(&img.row(y)[w.x0..w.x1]);
-        }
-        // The motion plane keeps the votes of the pairs in the kept frames: the newest pair is
-        // added, and the pair that drops out of the window is taken off.
-        let n = w.width() * w.height();
-        if self.frames.is_empty() {
-            self.plane.clear();
-            self.plane.resize(n, 0);
-        }
-        let vote = self.vote;
-        let votes = |a: &GrayBuf, b: &GrayBuf, plane: &mut [u32], add: bool| {
-            for ((p, &x), &y) in plane.iter_mut().zip(&a.data).zip(&b.data) {
-                let d = x.abs_diff(y);
-                let v = match vote {
-                    ActivityVote::Difference => u32::from(d),
-                    ActivityVote::Threshold(t) => u32::from(d > t),
-                };
-                *p = if add { *p + v } else { *p - v };
-            }
-        };
-        if let Some(last) = self.frames.back() {
-            votes(last, &buf, &mut self.plane, true);
-        }
-        self.frames.push_back(buf);
-        while self.frames.len() > self.depth {
-            if let (Some(old), Some(next)) = (self.frames.front(), self.frames.get(1)) {
-                votes(old, next, &mut self.plane, false);
-            }
-            if let Some(old) = self.frames.pop_front() {
-                self.spare.push(old);
-            }
-        }
-        if self.frames.len() < 2 {
-            return Ok(None);
-        }
-        let pairs = (self.frames.len() - 1) as f64;
-        // Integer moments row by row (exact: at most 255 x 15 votes a pixel).
-        let (mut sum, mut sx, mut sy) = (0u64, 0u64, 0u64);
-        for (y, row) in self.plane.chunks_exact(w.width()).enumerate() {
-            let (rs, rx) = row
-                .iter()
-                .enumerate()
-                .fold((0u64, 0u64), |(s, x), (i, &p)| (s + u64::from(p), x + i as u64 * u64::from(p)));
-            (sum, sx, sy) = (sum + rs, sx + rx, sy + y as u64 * rs);
-        }
-        let (sum, sx, sy) = (sum as f64, sx as f64 + 0.5 * sum as f64, sy as f64 + 0.5 * sum as f64);
-        if sum == 0.0 {
-            return Ok(Some(Activity { centroid: [f32::NAN; 2], strength: 0.0 }));
-        }
-        let centroid = [(w.x0 as f64 + sx / sum) as f32, (w.y0 as f64 + sy / sum) as f32];
-        Ok(Some(Activity { centroid, strength: (sum / pairs / n as f64) as f32 }))
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::image::GrayBuf;
 
     #[test]
     fn the_brightest_region_is_the_lamp() {

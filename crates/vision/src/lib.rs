@@ -2,6 +2,7 @@
 //! or a state machine with reusable buffers, no IO, no clock. The vision-workers service runs them
 //! on camera frames in shared memory, inside the windows it is asked to look in.
 
+mod activity;
 mod cross;
 pub mod cues;
 pub mod depth;
@@ -12,6 +13,7 @@ pub mod image;
 pub mod levels;
 pub mod moravec;
 pub mod nc;
+mod nc_pass;
 pub mod noise;
 pub mod path;
 pub mod pyramid;

@@ -6,11 +6,13 @@
 //! needs the template; `S_P` and `ΣP²` come from integral images. ΣPT is computed as
 //! `Σ P (T - 128) + 128 S_P`, so the template fits signed bytes and, where the CPU has AVX-512
 //! VNNI, sixty-four byte products go into one instruction (`cross.rs`, with an AVX2 and a
-//! portable form of the same sums). The scoring pass is one body compiled for each
-//! [`Path`](crate::simd::Path).
+//! portable form of the same sums). The patch sums and scores are one body compiled for each
+//! [`Path`](crate::simd::Path) (`nc_pass.rs`); [`Correlator::best`] leaves out the blocks of
+//! placements whose score bound shows they cannot hold the best.
 
-use crate::cross::{BLOCK_X, BLOCK_Y, Packed, cross};
+use crate::cross::{BLOCK_X, BLOCK_Y, Packed, cross, cross_one};
 use crate::image::{Gray, GrayBuf, Rect, VisionError};
+use crate::nc_pass::{Best, Consts, Scoring, Sums, Window, may_reach, nc, score_blocks};
 use crate::simd::Path;
 
 /// Largest template side: keeps `Σ P (T - 128)` inside an `i32`.
@@ -73,19 +75,19 @@ pub struct Match {
 pub struct Correlator {
     pad: Vec<u8>,
     pad_width: usize,
-    /// Per column of the window: the sums of pixels and squares over the template's rows.
-    col_sums: Vec<u32>,
-    col_squares: Vec<u32>,
-    /// Running sums of those along the row (wrapping: only differences are used).
-    run_sums: Vec<u32>,
-    run_squares: Vec<u32>,
+    sums: Sums,
     cross: Vec<i32>,
     scores: Vec<f32>,
+    blocks: Vec<u32>,
     nx: usize,
     ny: usize,
     /// The instruction-set path, if not [`Path::active`] (tests and benchmarks set it).
     path: Option<Path>,
 }
+
+/// Blocks whose cross-sums are taken at once by [`Correlator::best`] before the bound is
+/// raised to the best score found.
+const BATCH: usize = 64;
 
 impl Correlator {
     /// Runs on `path` from now on (lowered to the fastest the CPU has): every path gives the
@@ -102,27 +104,12 @@ impl Correlator {
     /// Scores every placement of `t` whose pixels all lie in `window`: row-major, `nx x ny`
     /// (see [`Correlator::placements`]), the top-left placement first.
     pub fn correlate(&mut self, img: &Gray<'_>, window: Rect, t: &Template) -> Result<&[f32], VisionError> {
-        let w = window.inside(img.width, img.height)?;
-        if t.width > w.width() || t.height > w.height() {
-            return Err(VisionError::TemplateTooLarge(t.width, t.height, w));
-        }
-        let (nx, ny) = (w.width() - t.width + 1, w.height() - t.height + 1);
-        (self.nx, self.ny) = (nx, ny);
-        self.copy_padded(img, w, t);
-        self.cross.clear();
-        self.cross.resize(nx.next_multiple_of(BLOCK_X) * ny.next_multiple_of(BLOCK_Y), 0);
-        let path = self.path();
-        cross(path, &self.pad, self.pad_width, nx, ny, &t.packed, &mut self.cross);
-        match path {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: `path()` is one the CPU has.
-            Path::Avx512 => unsafe { score_avx512(self, w, t) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as above.
-            Path::Avx2 => unsafe { score_avx2(self, w, t) },
-            _ => score(self, w, t),
-        }
-        Ok(&self.scores)
+        let k = self.prepare(img, window, t)?;
+        self.blocks.clear();
+        self.blocks.extend(0..self.sums.bound.len() as u32);
+        let mut best = Best::default();
+        self.run(t, &k, &mut best);
+        Ok(&self.scores[..self.nx * self.ny])
     }
 
     /// Placements per row and rows of placements of the last correlation.
@@ -130,7 +117,10 @@ impl Correlator {
         (self.nx, self.ny)
     }
 
-    /// The best placement of `t` in `window`.
+    /// The best placement of `t` in `window`: the first (row-major) of the highest scores of
+    /// [`Correlator::correlate`], and the same match, bit for bit. Blocks of placements whose
+    /// score bound (`nc_pass.rs`) is below a score already found are not correlated: the block
+    /// with the highest bound first, then the others in order, a batch at a time.
     pub fn best(&mut self, img: &Gray<'_>, window: Rect, t: &Template) -> Result<Match, VisionError> {
         self.best_at(img, window, t, (0, 0))
     }
@@ -144,16 +134,27 @@ impl Correlator {
         t: &Template,
         origin: (usize, usize),
     ) -> Result<Match, VisionError> {
-        self.correlate(img, window, t)?;
+        let k = self.prepare(img, window, t)?;
+        let (bounds, n) = (&self.sums.bound, self.sums.bound.len());
+        let first = (0..n).fold(0, |b, i| if bounds[i] > bounds[b] { i } else { b });
+        let mut best = Best::default();
+        self.blocks.clear();
+        self.blocks.push(first as u32);
+        self.run(t, &k, &mut best);
+        for start in (0..n).step_by(BATCH) {
+            self.blocks.clear();
+            let bounds = &self.sums.bound[start..(start + BATCH).min(n)];
+            let todo =
+                bounds.iter().enumerate().filter(|&(i, &b)| start + i != first && may_reach(b, best.score));
+            self.blocks.extend(todo.map(|(i, _)| (start + i) as u32));
+            self.run(t, &k, &mut best);
+        }
         let (nx, ny) = (self.nx, self.ny);
-        let (i, score) = self
-            .scores
-            .iter()
-            .copied()
-            .enumerate()
-            .fold((0, f32::MIN), |b, (i, s)| if s > b.1 { (i, s) } else { b });
-        let (px, py) = (i % nx, i / nx);
-        let at = |x: usize, y: usize| self.scores[y * nx + x];
+        let (px, py, score) = (best.index % nx, best.index / nx, best.score);
+        let at = |x: usize, y: usize| {
+            let i = y * nx + x;
+            nc(&k, self.sums.sp[i], self.sums.spp[i], cross_one(&self.pad, self.pad_width, &t.packed, x, y))
+        };
         let vertex = |a: f32, b: f32, c: f32| {
             let d = a - 2.0 * b + c;
             if d < 0.0 { (0.5 * (a - c) / d).clamp(-0.5, 0.5) } else { 0.0 }
@@ -163,6 +164,38 @@ impl Correlator {
         let (x, y) = (origin.0 + window.x0 + px, origin.1 + window.y0 + py);
         let centre = [x as f32 + t.width as f32 / 2.0 + dx, y as f32 + t.height as f32 / 2.0 + dy];
         Ok(Match { x, y, centre, score })
+    }
+
+    /// Checks the request, copies the window and takes the patch sums and bounds.
+    fn prepare(&mut self, img: &Gray<'_>, window: Rect, t: &Template) -> Result<Consts, VisionError> {
+        let w = window.inside(img.width, img.height)?;
+        if t.width > w.width() || t.height > w.height() {
+            return Err(VisionError::TemplateTooLarge(t.width, t.height, w));
+        }
+        let (nx, ny) = (w.width() - t.width + 1, w.height() - t.height + 1);
+        (self.nx, self.ny) = (nx, ny);
+        self.copy_padded(img, w, t);
+        // Every block's cross sums are written before they are read: no need to clear.
+        let cells = nx.next_multiple_of(BLOCK_X) * ny.next_multiple_of(BLOCK_Y);
+        if self.cross.len() < cells {
+            self.cross.resize(cells, 0);
+        }
+        self.scores.resize(nx * ny, 0.0);
+        let k = Consts::new(t.sum, t.sum_sq, t.width, t.height);
+        let win = Window { pad: &self.pad, pw: self.pad_width, ww: w.width(), nx, ny };
+        self.sums.fill(self.path(), &win, &k);
+        Ok(k)
+    }
+
+    /// Cross sums and scores of `self.blocks`, the best kept in `best`.
+    fn run(&mut self, t: &Template, k: &Consts, best: &mut Best) {
+        if self.blocks.is_empty() {
+            return;
+        }
+        let (path, nx, ny) = (self.path(), self.nx, self.ny);
+        cross(path, &self.pad, self.pad_width, nx, &t.packed, &self.blocks, &mut self.cross);
+        let s = Scoring { sums: &self.sums, cross: &self.cross, scores: &mut self.scores, nx, ny };
+        score_blocks(path, s, k, &self.blocks, best);
     }
 
     /// The window's pixels in rows padded with zeros, so that whole blocks can be read past the
@@ -177,108 +210,6 @@ impl Correlator {
             self.pad[i * self.pad_width..i * self.pad_width + w.width()]
                 .copy_from_slice(&img.row(y)[w.x0..w.x1]);
         }
-    }
-}
-
-/// Scores row by row: column sums over the template's height slide down a row at a time,
-/// running sums along the row give each placement's `S_P` and `ΣP²` as a difference.
-#[inline(always)]
-fn score(c: &mut Correlator, w: Rect, t: &Template) {
-    let (nx, ny, ww, pw) = (c.nx, c.ny, w.width(), c.pad_width);
-    let cross_stride = nx.next_multiple_of(BLOCK_X);
-    c.scores.clear();
-    c.scores.resize(nx * ny, 0.0);
-    for v in [&mut c.col_sums, &mut c.col_squares] {
-        v.clear();
-        v.resize(ww, 0);
-    }
-    for v in [&mut c.run_sums, &mut c.run_squares] {
-        v.clear();
-        v.resize(ww + 1, 0);
-    }
-    for r in 0..t.height {
-        add_row(&mut c.col_sums, &mut c.col_squares, &c.pad[r * pw..r * pw + ww]);
-    }
-    for y in 0..ny {
-        if y > 0 {
-            let (old, new) = ((y - 1) * pw, (y - 1 + t.height) * pw);
-            slide_row(&mut c.col_sums, &mut c.col_squares, &c.pad[old..old + ww], &c.pad[new..new + ww]);
-        }
-        running(&c.col_sums, &mut c.run_sums[1..]);
-        running(&c.col_squares, &mut c.run_squares[1..]);
-        let sums = RowSums { run: &c.run_sums, squares: &c.run_squares, cross: &c.cross[y * cross_stride..] };
-        score_row(sums, t, &mut c.scores[y * nx..(y + 1) * nx]);
-    }
-}
-
-/// [`score`] compiled for AVX-512.
-///
-/// # Safety
-/// The CPU must have the features of [`Path::Avx512`].
-#[multiversion::target("x86_64+avx2+fma+bmi2+avx512f+avx512bw+avx512vnni")]
-unsafe fn score_avx512(c: &mut Correlator, w: Rect, t: &Template) {
-    score(c, w, t)
-}
-
-/// [`score`] compiled for AVX2 and FMA (which it does not fuse: the sums are the portable ones).
-///
-/// # Safety
-/// The CPU must have the features of [`Path::Avx2`].
-#[multiversion::target("x86_64+avx2+fma+bmi2")]
-unsafe fn score_avx2(c: &mut Correlator, w: Rect, t: &Template) {
-    score(c, w, t)
-}
-
-#[inline(always)]
-fn add_row(sums: &mut [u32], squares: &mut [u32], row: &[u8]) {
-    for ((s, q), &p) in sums.iter_mut().zip(squares.iter_mut()).zip(row) {
-        *s += u32::from(p);
-        *q += u32::from(p) * u32::from(p);
-    }
-}
-
-#[inline(always)]
-fn slide_row(sums: &mut [u32], squares: &mut [u32], old: &[u8], new: &[u8]) {
-    for (((s, q), &o), &n) in sums.iter_mut().zip(squares.iter_mut()).zip(old).zip(new) {
-        *s = s.wrapping_add(u32::from(n)).wrapping_sub(u32::from(o));
-        *q = q.wrapping_add(u32::from(n) * u32::from(n)).wrapping_sub(u32::from(o) * u32::from(o));
-    }
-}
-
-/// One row of placements' running sums and cross sums.
-struct RowSums<'a> {
-    run: &'a [u32],
-    squares: &'a [u32],
-    cross: &'a [i32],
-}
-
-/// Running (wrapping) sums of `v` into `out`.
-#[inline(always)]
-fn running(v: &[u32], out: &mut [u32]) {
-    let mut acc = 0u32;
-    for (o, &x) in out.iter_mut().zip(v) {
-        acc = acc.wrapping_add(x);
-        *o = acc;
-    }
-}
-
-/// NC for one row of placements. Window sums stay below 2^31 (at most 128 x 128 x 255²), so
-/// they convert as `i32`, which vectorises.
-#[inline(always)]
-fn score_row(r: RowSums<'_>, t: &Template, out: &mut [f32]) {
-    let (st, stt, tw) = (t.sum as f32, t.sum_sq as f32, t.width);
-    let st2 = st * st;
-    let n = out.len();
-    let (lo, hi) = (&r.run[..n], &r.run[tw..tw + n]);
-    let (qlo, qhi) = (&r.squares[..n], &r.squares[tw..tw + n]);
-    let cross = &r.cross[..n];
-    for (x, o) in out.iter_mut().enumerate() {
-        let sp = hi[x].wrapping_sub(lo[x]) as i32 as f32;
-        let spp = qhi[x].wrapping_sub(qlo[x]) as i32 as f32;
-        let spt = cross[x] as f32 + 128.0 * sp;
-        // A black patch (S_P = 0) has numerator 0 too: it scores 0.
-        let den = (spp * st2 + stt * sp * sp).max(f32::MIN_POSITIVE);
-        *o = 2.0 * spt * sp * st / den;
     }
 }
 

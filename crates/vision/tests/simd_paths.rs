@@ -1,13 +1,15 @@
 //! Every instruction-set path this CPU has (`harvey_vision::simd::Path::available`) gives the
 //! same results, bit for bit, as the portable one: correlation scores and matches, Moravec
 //! interest maps and corners, and coarse-to-fine matches, on random images of odd widths (1, 15,
-//! 17, 641 px: no path may read past a row end or lose the last pixels) and on rendered frames.
+//! 17, 641 px: no path may read past a row end or lose the last pixels) and on rendered frames;
+//! and the pruned search of `Correlator::best` gives the exhaustive search's match, bit for bit,
+//! with templates cut from the frame searched (best score 1) and from another frame (below 1).
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use harvey_msgs::Encoding;
 use harvey_render::Renderer;
 use harvey_vision::moravec::{Moravec, MoravecParams};
-use harvey_vision::nc::{Correlator, Template};
+use harvey_vision::nc::{Correlator, Match, Template};
 use harvey_vision::pyramid::{Pyramid, coarse_to_fine};
 use harvey_vision::simd::Path;
 use harvey_vision::{Gray, GrayBuf, Rect};
@@ -42,8 +44,13 @@ fn correlation_agrees(img: &Gray<'_>, win: Rect, at: Rect) {
     let Ok(t) = Template::new(&GrayBuf::crop(img, at).expect("crop")) else { return };
     let mut want = Correlator::default();
     want.set_path(Path::Portable);
-    let scores = bits(want.correlate(img, win, &t).expect("correlates"));
+    let all = want.correlate(img, win, &t).expect("correlates").to_vec();
+    let scores = bits(&all);
     let best = want.best(img, win, &t).expect("best");
+    // The pruned search gives the exhaustive one's match, bit for bit.
+    let (nx, ny) = want.placements();
+    let exhaustive = exhaustive_best(&all, nx, ny, win, (t.width, t.height));
+    assert_eq!(format!("{best:?}"), format!("{exhaustive:?}"), "pruned vs exhaustive: {win}, {at}");
     for path in Path::available() {
         let mut c = Correlator::default();
         c.set_path(path);
@@ -51,6 +58,40 @@ fn correlation_agrees(img: &Gray<'_>, win: Rect, at: Rect) {
         assert_eq!(bits(c.correlate(img, win, &t).expect("correlates")), scores, "{path}: {win}, {at}");
         let got = c.best(img, win, &t).expect("best");
         assert_eq!(format!("{got:?}"), format!("{best:?}"), "{path}: {win}, {at}");
+    }
+}
+
+/// The best placement as the definition has it: the first of the highest scores of every
+/// placement, refined by parabolas through its neighbours.
+fn exhaustive_best(scores: &[f32], nx: usize, ny: usize, win: Rect, (tw, th): (usize, usize)) -> Match {
+    let (i, score) =
+        scores.iter().copied().enumerate().fold((0, f32::MIN), |b, (i, s)| if s > b.1 { (i, s) } else { b });
+    let (px, py) = (i % nx, i / nx);
+    let at = |x: usize, y: usize| scores[y * nx + x];
+    let vertex = |a: f32, b: f32, c: f32| {
+        let d = a - 2.0 * b + c;
+        if d < 0.0 { (0.5 * (a - c) / d).clamp(-0.5, 0.5) } else { 0.0 }
+    };
+    let dx = if px > 0 && px + 1 < nx { vertex(at(px - 1, py), score, at(px + 1, py)) } else { 0.0 };
+    let dy = if py > 0 && py + 1 < ny { vertex(at(px, py - 1), score, at(px, py + 1)) } else { 0.0 };
+    let (x, y) = (win.x0 + px, win.y0 + py);
+    let centre = [x as f32 + tw as f32 / 2.0 + dx, y as f32 + th as f32 / 2.0 + dy];
+    Match { x, y, centre, score }
+}
+
+/// A template cut from `from` at `at`, searched for in `img` (so that the best score is below 1
+/// and the pruned search has to find it among near misses), on each path.
+fn correlation_agrees_across(img: &Gray<'_>, from: &Gray<'_>, win: Rect, at: Rect) {
+    let Ok(t) = Template::new(&GrayBuf::crop(from, at).expect("crop")) else { return };
+    let mut want = Correlator::default();
+    want.set_path(Path::Portable);
+    let all = want.correlate(img, win, &t).expect("correlates").to_vec();
+    let (nx, ny) = want.placements();
+    let exhaustive = format!("{:?}", exhaustive_best(&all, nx, ny, win, (t.width, t.height)));
+    for path in Path::available() {
+        let mut c = Correlator::default();
+        c.set_path(path);
+        assert_eq!(format!("{:?}", c.best(img, win, &t).expect("best")), exhaustive, "{path}: {win}, {at}");
     }
 }
 
@@ -82,6 +123,8 @@ fn random_images_of_odd_widths_agree_on_every_path() {
             }
             let at = Rect::new(w - tw, h - th, w, h);
             correlation_agrees(&v, v.full(), at);
+            let other = random(w, h, (w * 7 + h) as u64);
+            correlation_agrees_across(&v, &other.view(), v.full(), at);
             if w > tw + 2 && h > th + 1 {
                 correlation_agrees(&v, Rect::new(1, 1, w - 1, h), at.clamp_to(1, 1));
             }
@@ -105,6 +148,15 @@ fn rendered_frames_agree_on_every_path() {
             let at = Rect::new(cx, cy, cx + side, cy + side);
             correlation_agrees(&v, v.full(), at);
             moravec_agrees(&v, v.full());
+        }
+        // Templates from the other pose's frame: best scores below 1, found among near misses.
+        let (a, b) = (rendered(w, h, poses[0]), rendered(w, h, poses[1]));
+        let side = 16.min(w as usize).min(h as usize);
+        for (x, y) in [(0, 0), (w as usize / 3, h as usize / 2), (w as usize - side, h as usize - side)] {
+            let (x, y) = (x.min(w as usize - side), y.min(h as usize - side));
+            let at = Rect::new(x, y, x + side, y + side);
+            correlation_agrees_across(&b.view(), &a.view(), b.view().full(), at);
+            correlation_agrees_across(&a.view(), &b.view(), a.view().full(), at);
         }
     }
     // Coarse-to-fine over whole-frame and windowed pyramids, on each path.
