@@ -35,15 +35,18 @@ def main() -> int:
     failures = []
     jazzy = get_typestore(Stores.ROS2_JAZZY)
     with AnyReader([path]) as reader:
-        # The recording's own definitions, hashed as ROS 2 does, against Jazzy's.
+        # Each channel's own definition (its dependencies appended, as rosbag2 does), hashed as
+        # ROS 2 does, against Jazzy's.
         for conn in reader.connections:
             if conn.msgtype in STANDARD:
                 own = get_typestore(Stores.EMPTY)
                 own.register(get_types_from_msg(conn.msgdef.data, conn.msgtype))
-                for dep_name, dep in reader.typestore.fielddefs.items():
-                    if dep_name not in own.fielddefs:
-                        own.register({dep_name: dep})
-                if own.hash_rihs01(conn.msgtype) != jazzy.hash_rihs01(conn.msgtype):
+                try:
+                    ours = own.hash_rihs01(conn.msgtype)
+                except KeyError as missing:
+                    failures.append(f"{conn.topic}: its {conn.msgtype} definition lacks {missing}")
+                    continue
+                if ours != jazzy.hash_rihs01(conn.msgtype):
                     failures.append(f"{conn.topic}: {conn.msgtype} differs from ROS 2 Jazzy's")
         edges = defaultdict(list)  # child -> [(stamp, parent)]
         static = {}

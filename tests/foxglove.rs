@@ -43,6 +43,11 @@ fn number(v: &Value) -> u64 {
         .unwrap_or_else(|| panic!("{v} is no number"))
 }
 
+/// The derived topics matched with the recording by log time too (the others by bytes alone).
+fn stamped(topic: &str) -> bool {
+    topic == "/tf" || topic == "/camera/camera_info"
+}
+
 #[test]
 fn a_foxglove_client_sees_every_topic_live_as_it_is_recorded() {
     let modules = node_modules();
@@ -89,6 +94,8 @@ fn a_foxglove_client_sees_every_topic_live_as_it_is_recorded() {
         ("tf_static", 1),
         ("markers/map", 1),
         ("markers/uncertainty", 10),
+        // From each frame's header, whether or not a client watches the frames.
+        ("camera/camera_info", 10),
     ];
     let mut client = Command::new("node");
     client.arg(common::repo().join("scripts/foxglove_client.mjs")).arg("--modules").arg(&modules);
@@ -98,6 +105,7 @@ fn a_foxglove_client_sees_every_topic_live_as_it_is_recorded() {
     }
     client.args(["--echo", "odometry", "--echo", "sonar/ring", "--echo", "camera/frame"]);
     client.args(["--echo", "tf", "--echo", "tf_static", "--echo", "markers/map"]);
+    client.args(["--echo", "camera/camera_info"]);
     let out = client.output().expect("node runs the client");
     let lines: Vec<Value> = String::from_utf8_lossy(&out.stdout)
         .lines()
@@ -154,12 +162,13 @@ fn a_foxglove_client_sees_every_topic_live_as_it_is_recorded() {
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
     let mcap = std::fs::read(dir.join("run.mcap")).expect("recording");
     let mut recorded: BTreeMap<(String, u64), Vec<u8>> = BTreeMap::new();
-    // The derived topics, by bytes (and, for /tf, log time): the bridge numbers its own.
+    // The derived topics, by bytes (and, for /tf and the camera's calibration, log time): the
+    // bridge numbers its own.
     let mut recorded_derived = std::collections::BTreeSet::new();
     for m in mcap::MessageStream::new(&mcap).expect("mcap") {
         let m = m.expect("message");
         if harvey_recording::derive::is_derived(&m.channel.topic) {
-            let at = if m.channel.topic == "/tf" { m.log_time } else { 0 };
+            let at = if stamped(&m.channel.topic) { m.log_time } else { 0 };
             recorded_derived.insert((m.channel.topic.clone(), at, m.data.into_owned()));
             continue;
         }
@@ -182,9 +191,9 @@ fn a_foxglove_client_sees_every_topic_live_as_it_is_recorded() {
             *matched.entry(topic).or_default() += 1;
         }
     }
-    for topic in ["/tf", "/tf_static", "/markers/map"] {
+    for topic in ["/tf", "/tf_static", "/markers/map", "/camera/camera_info"] {
         for m in of(topic) {
-            let at = if topic == "/tf" { number(&m["log_time"]) } else { 0 };
+            let at = if stamped(topic) { number(&m["log_time"]) } else { 0 };
             let data = from_hex(m["cdr"].as_str().expect("cdr"));
             assert!(
                 recorded_derived.contains(&(topic.to_owned(), at, data)),
@@ -194,7 +203,9 @@ fn a_foxglove_client_sees_every_topic_live_as_it_is_recorded() {
         }
     }
     assert!(
-        matched.get("/tf").is_some_and(|&n| n >= 40) && matched.contains_key("/markers/map"),
+        matched.get("/tf").is_some_and(|&n| n >= 40)
+            && matched.contains_key("/markers/map")
+            && matched.get("/camera/camera_info").is_some_and(|&n| n >= 10),
         "{matched:?}"
     );
     // And the decoded values are the recorded message's.

@@ -10,10 +10,16 @@ use harvey_cdr::{
     CameraInfo, CdrError, Def, MarkerArray, Ros2Msg, TfMessage, Transform, decode, decode_image, encode,
     frames,
 };
-use harvey_msgs::{MissionStatus, Odometry, PlanSketch, Pose2, TruePose, UncertaintyMap, topics};
+use harvey_msgs::{
+    FrameHeader, MissionStatus, Odometry, PlanSketch, Pose2, TruePose, UncertaintyMap, topics,
+};
 use harvey_world::World;
 
+mod camera_info;
 mod markers;
+
+pub use camera_info::camera_info;
+use camera_info::check_frame;
 
 /// The derived topics (without the leading `/`), their types, and whether a late joiner must
 /// still get their last message (`/tf_static`, the map: ROS's transient-local durability).
@@ -104,10 +110,7 @@ impl Deriver {
         if is_derived(t) {
             return Ok(());
         }
-        if !self.started {
-            self.started = true;
-            self.statics(stamp_ns, out);
-        }
+        self.start(stamp_ns, out);
         match t {
             _ if t == topics::SIM_TRUTH.name => {
                 let p = decode::<TruePose>(data)?.world_from_robot;
@@ -126,20 +129,10 @@ impl Deriver {
                 let m = markers::uncertainty(stamp_ns, &decode::<UncertaintyMap>(data)?);
                 self.push(UNCERTAINTY_MARKERS, stamp_ns, encode(&m, Vec::new()), out);
             }
-            _ if t == topics::CAMERA_FRAME.name => {
-                let Some(world) = &self.world else { return Ok(()) };
+            // Without the world, no calibration (and the frame is not decoded).
+            _ if t == topics::CAMERA_FRAME.name && self.world.is_some() => {
                 let (h, _) = decode_image(data)?;
-                let (w, ht) = (h.width_px, h.height_px);
-                // Harvey's pixel (u, v) covers [u, u + 1); ROS puts its centre at (u, v).
-                let info = CameraInfo {
-                    stamp_ns: h.stamp_ns,
-                    frame_id: frames::CAMERA.into(),
-                    width_px: w,
-                    height_px: ht,
-                    focal_px: world.camera.focal_for(w),
-                    centre_px: [f64::from(w) / 2.0 - 0.5, f64::from(ht) / 2.0 - 0.5],
-                };
-                self.push(CAMERA_INFO, stamp_ns, encode(&info, Vec::new()), out);
+                self.calibration(stamp_ns, &h, out);
             }
             _ if t == topics::EXECUTIVE_PLAN.name => {
                 let m = markers::plan(stamp_ns, &decode::<PlanSketch>(data)?);
@@ -148,6 +141,37 @@ impl Deriver {
             _ => {}
         }
         Ok(())
+    }
+
+    /// What a camera frame adds, from its header alone (read in place; its pixels `pixel_bytes`
+    /// long, not encoded): byte for byte what [`Deriver::derive`] makes of the frame recorded.
+    pub fn derive_frame(
+        &mut self,
+        h: &FrameHeader,
+        pixel_bytes: usize,
+        out: &mut Vec<Derived>,
+    ) -> Result<(), CdrError> {
+        self.start(h.stamp_ns, out);
+        if self.world.is_some() {
+            check_frame(h, pixel_bytes)?;
+            self.calibration(h.stamp_ns, h, out);
+        }
+        Ok(())
+    }
+
+    /// The first message of a recording brings the static transforms and the map.
+    fn start(&mut self, stamp_ns: u64, out: &mut Vec<Derived>) {
+        if !self.started {
+            self.started = true;
+            self.statics(stamp_ns, out);
+        }
+    }
+
+    /// `/camera/camera_info` for the frame `h`, logged at `stamp_ns`, when the world is known.
+    fn calibration(&mut self, stamp_ns: u64, h: &FrameHeader, out: &mut Vec<Derived>) {
+        let Some(world) = &self.world else { return };
+        let info = camera_info(h, world);
+        self.push(CAMERA_INFO, stamp_ns, encode(&info, Vec::new()), out);
     }
 
     /// `world → odom` once a tick's odometry and estimate are both in, whichever came first (a

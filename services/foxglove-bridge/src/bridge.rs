@@ -93,7 +93,9 @@ impl Bridge {
     }
 
     /// Takes every queued message of tap `i` and logs it to its channel (when a client is
-    /// subscribed), and whatever the hook derives from it to theirs.
+    /// subscribed), and whatever the hook derives from it to theirs. A message is encoded only
+    /// for a subscribed client or a hook that wants it in CDR: a camera frame's header goes to
+    /// the hook as read in place, its pixels unencoded while nobody watches the frames.
     pub fn forward(&mut self, i: usize, tap: &dyn Tap) -> anyhow::Result<usize> {
         let Some(ch) = self.channels.get(i).cloned() else {
             anyhow::bail!("no channel for tap {i} ({})", tap.topic());
@@ -105,12 +107,14 @@ impl Bridge {
         let (hook, out) = (&mut self.hook, &mut self.out);
         let n = tap.take(encode, &mut self.buf, &mut |m| {
             newest = newest.max(m.stamp_ns);
-            if !encode {
-                return;
-            }
-            if ch.has_sinks() {
+            if encode && ch.has_sinks() {
                 ch.log_with_meta(m.cdr, PartialMetadata::with_log_time(m.stamp_ns));
                 sent += 1;
+            }
+            if let Some((h, pixel_bytes)) = m.frame
+                && let Err(e) = hook.derive_frame(&h, pixel_bytes, out)
+            {
+                failed.get_or_insert(e);
             }
             if wanted && let Err(e) = hook.derive(topic, m.stamp_ns, m.cdr, out) {
                 failed.get_or_insert(e);
@@ -190,6 +194,30 @@ mod tests {
         let other = bridge.derived_channel("/static", <Odometry as harvey_cdr::Ros2Msg>::DEF);
         assert!(other.is_err(), "one topic keeps one definition");
         drop((odometry, bridge, taps, bus));
+        harvey_bus::retire_domain(&prefix).expect("retire");
+    }
+
+    #[test]
+    fn unwatched_frames_bring_their_calibration_without_being_encoded() {
+        let prefix = format!("tfoxframes{}_", std::process::id());
+        let bus = Bus::join_with_prefix("foxglove-bridge-test", &prefix).expect("bus");
+        let taps = crate::taps::open_all(&bus).expect("taps");
+        let latched = Arc::new(Latched::default());
+        let world = crate::derive::tests::world();
+        let mut bridge =
+            Bridge::new(&taps, crate::derive::hook(Some(&world)), latched.clone()).expect("bridge");
+        let header = harvey_msgs::FrameHeader::new(1, 50_000_000, 64, 48, harvey_msgs::Encoding::Mono8);
+        let frames = bus.frame_publisher(topics::CAMERA_FRAME, header.payload_len()).expect("publisher");
+        let mut loan = frames.loan(header).expect("loan");
+        loan.pixels_mut().fill(9);
+        loan.send().expect("send");
+        let i = taps.iter().position(|t| t.topic() == topics::CAMERA_FRAME.name).expect("frames");
+        assert_eq!(bridge.forward(i, taps[i].as_ref()).expect("forward"), 1);
+        assert_eq!(bridge.counts()[i], Counts { taken: 1, sent: 0 }, "no client: nothing sent");
+        assert_eq!(bridge.buf.capacity(), 0, "nothing encoded");
+        assert_eq!(latched.len(), 2, "the frame, the first message, brought /tf_static and the map");
+        assert_eq!(bridge.newest_ns, 50_000_000);
+        drop((frames, bridge, taps, bus));
         harvey_bus::retire_domain(&prefix).expect("retire");
     }
 }

@@ -1,11 +1,13 @@
 //! The hook for derived channels: messages computed from the bus messages (`/tf`, `/tf_static`,
-//! `/markers`, ...) and published beside them. Each bus message is offered to a [`Derive`] as
-//! (topic, stamp, CDR bytes); what it returns is published on a channel of its own, created on
-//! first use with the message's `ros2msg` schema.
+//! `/markers`, ...) and published beside them. Each bus message of a topic the [`Derive`] wants
+//! is offered to it as (topic, stamp, CDR bytes), and each camera frame's header, read in place,
+//! as it is (the pixels are not encoded for it); what it returns is published on a channel of
+//! its own, created on first use with the message's `ros2msg` schema.
 //!
-//! [`hook`] derives what the recorder derives (`harvey_recording::derive`: `/tf`, `/tf_static`
-//! and the markers), from the messages the bridge takes, in the order it takes them. Topics not
-//! advertised up front are created on first use, not latched.
+//! [`hook`] derives what the recorder derives (`harvey_recording::derive`: `/tf`, `/tf_static`,
+//! the markers and `/camera/camera_info`, the latter from the frame's header alone), from the
+//! messages the bridge takes, in the order it takes them. Topics not advertised up front are
+//! created on first use, not latched.
 //!
 //! Latched channels: a client that subscribes late still gets the last message of a channel
 //! whose messages hold until replaced (`/tf_static`, the map's markers: ROS's transient-local
@@ -18,7 +20,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use foxglove::websocket::{ChannelView, Client, ServerListener};
 use foxglove::{ChannelId, PartialMetadata, RawChannel};
 use harvey_cdr::Def;
-use harvey_msgs::topics;
+use harvey_msgs::{FrameHeader, topics};
 use harvey_recording::derive::{self, Deriver};
 use harvey_world::World;
 
@@ -37,8 +39,8 @@ pub struct Derived {
 
 /// Computes derived messages from the bus messages.
 pub trait Derive {
-    /// Whether messages of `topic` (`odometry`, no leading `/`) are wanted: those are encoded
-    /// and offered even while no client is subscribed to the topic itself.
+    /// Whether messages of `topic` (`odometry`, no leading `/`) are wanted in CDR: those are
+    /// encoded and offered even while no client is subscribed to the topic itself.
     fn wants(&self, topic: &str) -> bool;
 
     /// Offered one message of a wanted topic (in CDR, as recorded); pushes onto `out` what it
@@ -50,6 +52,17 @@ pub trait Derive {
         cdr: &[u8],
         out: &mut Vec<Derived>,
     ) -> anyhow::Result<()>;
+
+    /// Offered the header of each camera frame, read in place (its pixels `pixel_bytes` long),
+    /// whether or not anyone watches the frames; pushes onto `out` what it derives from it.
+    fn derive_frame(
+        &mut self,
+        _h: &FrameHeader,
+        _pixel_bytes: usize,
+        _out: &mut Vec<Derived>,
+    ) -> anyhow::Result<()> {
+        Ok(())
+    }
 
     /// The derived topics to advertise before their first message, with their definitions and
     /// whether they are latched: a client that subscribes late still gets the last message
@@ -71,10 +84,10 @@ struct Recorded {
     out: Vec<derive::Derived>,
 }
 
-/// The bus topics the derived ones come from.
-const SOURCES: [&str; 6] = [
+/// The bus topics the derived ones come from in CDR (the camera's calibration comes from each
+/// frame's header: [`Derive::derive_frame`]).
+const SOURCES: [&str; 5] = [
     topics::SIM_TRUTH.name,
-    topics::CAMERA_FRAME.name,
     topics::ODOMETRY.name,
     topics::EXECUTIVE_STATUS.name,
     topics::UMS_MAP.name,
@@ -96,16 +109,35 @@ impl Derive for Recorded {
         self.deriver
             .derive(topic, stamp_ns, cdr, &mut self.out)
             .map_err(|e| anyhow::anyhow!("deriving from {topic}: {e}"))?;
+        self.hand_over(out)
+    }
+
+    fn derive_frame(
+        &mut self,
+        h: &FrameHeader,
+        pixel_bytes: usize,
+        out: &mut Vec<Derived>,
+    ) -> anyhow::Result<()> {
+        self.deriver
+            .derive_frame(h, pixel_bytes, &mut self.out)
+            .map_err(|e| anyhow::anyhow!("deriving from {}: {e}", topics::CAMERA_FRAME.name))?;
+        self.hand_over(out)
+    }
+
+    fn advertised(&self) -> Vec<(String, &'static Def, bool)> {
+        derive::TOPICS.iter().map(|&(topic, def, latched)| (format!("/{topic}"), def, latched)).collect()
+    }
+}
+
+impl Recorded {
+    /// Moves what the deriver made onto `out`, with each topic's definition.
+    fn hand_over(&mut self, out: &mut Vec<Derived>) -> anyhow::Result<()> {
         for d in self.out.drain(..) {
             let def = derive::index(d.topic).map(|k| derive::TOPICS[k].1);
             let def = def.ok_or_else(|| anyhow::anyhow!("{} is not a derived topic", d.topic))?;
             out.push(Derived { topic: format!("/{}", d.topic), def, stamp_ns: d.stamp_ns, cdr: d.data });
         }
         Ok(())
-    }
-
-    fn advertised(&self) -> Vec<(String, &'static Def, bool)> {
-        derive::TOPICS.iter().map(|&(topic, def, latched)| (format!("/{topic}"), def, latched)).collect()
     }
 }
 
@@ -194,6 +226,34 @@ pub mod tests {
         let advertised = h.advertised();
         assert!(advertised.iter().any(|(t, _, latched)| t == "/tf_static" && *latched), "{advertised:?}");
         assert!(h.derive("odometry", 60, &[0, 1, 0, 0], &mut out).is_err(), "garbled bytes are an error");
+    }
+
+    pub fn world() -> World {
+        let text = include_str!("../../../worlds/hallway.toml");
+        harvey_world::load_str(text, "hallway.toml").expect("the hallway world loads")
+    }
+
+    #[test]
+    fn a_frame_header_brings_the_calibration_the_recorder_derives_from_the_frame() {
+        let world = world();
+        let frame = harvey_msgs::FrameHeader::new(2, 100_000_000, 640, 480, harvey_msgs::Encoding::Mono8);
+        let pixels = vec![0u8; frame.payload_len()];
+        let mut h = hook(Some(&world));
+        assert!(!h.wants(topics::CAMERA_FRAME.name), "frames are not encoded for the hook");
+        let mut out = Vec::new();
+        h.derive_frame(&frame, pixels.len(), &mut out).expect("derive");
+        let mut recorder = Deriver::new(Some(&world));
+        let mut recorded = Vec::new();
+        let cdr = harvey_cdr::encode_image(&frame, &pixels, Vec::new());
+        recorder.derive(topics::CAMERA_FRAME.name, frame.stamp_ns, &cdr, &mut recorded).expect("recorder");
+        let served: Vec<(String, u64, &[u8])> =
+            out.iter().map(|d| (d.topic.clone(), d.stamp_ns, d.cdr.as_slice())).collect();
+        let recorded: Vec<(String, u64, &[u8])> =
+            recorded.iter().map(|d| (format!("/{}", d.topic), d.stamp_ns, d.data.as_slice())).collect();
+        assert_eq!(served, recorded, "the recorder's messages, byte for byte");
+        assert!(served.iter().any(|(t, ..)| t == "/camera/camera_info"), "{served:?}");
+        let garbled = harvey_msgs::FrameHeader { encoding: 9, ..frame };
+        assert!(h.derive_frame(&garbled, pixels.len(), &mut out).is_err(), "as the recorder refuses it");
     }
 
     #[test]

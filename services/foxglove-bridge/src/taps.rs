@@ -1,16 +1,20 @@
 //! The bridge's taps: one subscription per Harvey topic, opened as an observer (not a party of
 //! the clock chain), each message handed over in CDR exactly as the recorder writes it
-//! (`harvey_cdr::encode`, `encode_image`) with its `ros2msg` schema (`harvey_cdr::full_text`).
+//! (`harvey_cdr::encode`, `encode_image`) with its `ros2msg` schema (`harvey_cdr::full_text`),
+//! when asked for: a camera frame's header comes with it either way, read in place.
 
 use harvey_bus::{Bus, FrameSubscriber, Subscriber, Waitable};
 use harvey_cdr::{Def, Ros2Msg, encode, encode_image, full_text, image_def};
-use harvey_msgs::{Message, Qos, Topic, topics};
+use harvey_msgs::{FrameHeader, Message, Qos, Topic, topics};
 
 /// One message taken from a topic.
 pub struct Taken<'a> {
     pub stamp_ns: u64,
     /// The message in CDR; empty when the caller did not ask for it.
     pub cdr: &'a [u8],
+    /// A camera frame's header, read in place, and its pixels' length, encoded or not: what
+    /// the camera's calibration is derived from. `None` for other messages.
+    pub frame: Option<(FrameHeader, usize)>,
 }
 
 /// A subscribed topic, whatever its type.
@@ -54,7 +58,7 @@ impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
                 *buf = encode(m, std::mem::take(buf));
             }
             let cdr = if want { buf.as_slice() } else { &[] };
-            f(Taken { stamp_ns: h.stamp_ns, cdr });
+            f(Taken { stamp_ns: h.stamp_ns, cdr, frame: None });
         })?)
     }
 }
@@ -83,14 +87,14 @@ impl Tap for FrameTap {
         while n < Qos::FRAMES.buffer
             && let Some(frame) = self.sub.take()?
         {
-            let h = *frame.header();
+            let (h, pixel_bytes) = (*frame.header(), frame.pixels().len());
             if want {
                 *buf = encode_image(&h, frame.pixels(), std::mem::take(buf));
             }
             // The slot goes back to the camera before the frame is sent on.
             drop(frame);
             let cdr = if want { buf.as_slice() } else { &[] };
-            f(Taken { stamp_ns: h.stamp_ns, cdr });
+            f(Taken { stamp_ns: h.stamp_ns, cdr, frame: Some((h, pixel_bytes)) });
             n += 1;
         }
         Ok(n)

@@ -144,3 +144,26 @@ fn each_frame_brings_its_calibration_with_the_world_and_none_without() {
     assert_eq!(info.focal_px, world.camera.focal_for(320), "the focal length scales with the frame");
     assert_eq!(info.centre_px, [159.5, 119.5]);
 }
+
+#[test]
+fn a_frame_header_read_in_place_derives_what_the_recorded_frame_derives() {
+    let world = world();
+    let h = harvey_msgs::FrameHeader::new(4, 1_250_000_000, 640, 480, harvey_msgs::Encoding::Rgb8);
+    let pixels = vec![7u8; h.payload_len()];
+    let frame = harvey_cdr::encode_image(&h, &pixels, Vec::new());
+    for w in [None, Some(&world)] {
+        let (mut recorded, mut in_place) = (Vec::new(), Vec::new());
+        let (mut r, mut p) = (Deriver::new(w), Deriver::new(w));
+        for _ in 0..2 {
+            r.derive(topics::CAMERA_FRAME.name, h.stamp_ns, &frame, &mut recorded).expect("recorded");
+            p.derive_frame(&h, pixels.len(), &mut in_place).expect("in place");
+        }
+        assert_eq!(in_place, recorded, "the same messages, numbered alike, byte for byte");
+    }
+    let mut d = Deriver::new(Some(&world));
+    let mut out = Vec::new();
+    assert!(d.derive_frame(&h, pixels.len() - 1, &mut out).is_err(), "pixels the header does not describe");
+    let unset = harvey_msgs::FrameHeader { encoding: 0, ..h };
+    assert!(d.derive_frame(&unset, pixels.len(), &mut out).is_err(), "an encoding the image cannot name");
+    assert!(out.iter().all(|m| m.topic != CAMERA_INFO), "neither brings a calibration");
+}
