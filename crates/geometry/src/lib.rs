@@ -5,9 +5,11 @@
 mod angle;
 mod pose;
 mod rng;
+mod segment;
 pub mod units;
 
 pub use angle::{wrap, wrap_deg};
 pub use pose::{Pose2, PoseParseError};
 pub use rng::Rng;
+pub use segment::distance_to_segment;
 pub use units::{FT, INCH};

@@ -1,6 +1,8 @@
 //! Convex-polygon geometry for the uncertainty map: hulls, half-plane slicing, areas,
 //! containment, enclosing arcs, and reducing a hull to a vertex budget without ever shrinking it.
 
+use harvey_geometry::distance_to_segment;
+
 pub type Pt = [f64; 2];
 
 fn cross(o: Pt, a: Pt, b: Pt) -> f64 {
@@ -51,14 +53,6 @@ pub fn contains(poly: &[Pt], p: Pt, tol: f64) -> bool {
             cross(a, b, p) / (b[0] - a[0]).hypot(b[1] - a[1]).max(1e-300) >= -tol
         }),
     }
-}
-
-fn distance_to_segment(a: Pt, b: Pt, p: Pt) -> f64 {
-    let e = [b[0] - a[0], b[1] - a[1]];
-    let len2 = e[0] * e[0] + e[1] * e[1];
-    let t =
-        if len2 > 0.0 { (((p[0] - a[0]) * e[0] + (p[1] - a[1]) * e[1]) / len2).clamp(0.0, 1.0) } else { 0.0 };
-    (a[0] + t * e[0] - p[0]).hypot(a[1] + t * e[1] - p[1])
 }
 
 /// The point of the convex polygon nearest to `p`.

@@ -3,7 +3,7 @@
 //! dock that lies outside the region (by more than the fix's own error) is a misreading, however
 //! sure the Hough was of the dock (002 §5: the UMS bounds what a sighting may say).
 
-use harvey_geometry::wrap;
+use harvey_geometry::{distance_to_segment, wrap};
 use harvey_msgs::{Pose2, UncertaintyMap};
 
 /// The UMS's region, as last published.
@@ -33,19 +33,12 @@ impl Region {
         let at = [p.x_m, p.y_m];
         let inside = harvey_world::topology::contains(&self.polygon, at)
             || (0..self.polygon.len()).any(|k| {
-                segment_distance(self.polygon[k], self.polygon[(k + 1) % self.polygon.len()], at) <= margin_m
+                distance_to_segment(self.polygon[k], self.polygon[(k + 1) % self.polygon.len()], at)
+                    <= margin_m
             });
         let off = wrap(p.heading_rad - self.heading_rad);
         inside && (-self.cw_rad - margin_rad..=self.ccw_rad + margin_rad).contains(&off)
     }
-}
-
-/// The distance from `p` to the segment `a`-`b`.
-fn segment_distance(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
-    let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-    let len2 = dx * dx + dy * dy;
-    let t = if len2 > 0.0 { (((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / len2).clamp(0.0, 1.0) } else { 0.0 };
-    (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)
 }
 
 #[cfg(test)]
