@@ -117,11 +117,9 @@ impl Profile {
                 })
                 .sum()
         };
-        let weights: Vec<(usize, f64)> = (k..k + span).map(|j| (j, weight(j))).collect();
-        let floor = 0.25 * weights.iter().map(|w| w.1).fold(0.0, f64::max);
-        let (sum, moment) = weights
-            .iter()
-            .map(|&(j, w)| ((w - floor).max(0.0), j))
+        let floor = 0.25 * (k..k + span).map(weight).fold(0.0, f64::max);
+        let (sum, moment) = (k..k + span)
+            .map(|j| ((weight(j) - floor).max(0.0), j))
             .fold((0.0, 0.0), |(s, m), (w, j)| (s + w, m + w * j as f64));
         if sum > 0.0 { moment / sum } else { k as f64 }
     }
