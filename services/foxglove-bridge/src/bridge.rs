@@ -158,12 +158,18 @@ mod tests {
     use harvey_bus::Bus;
     use harvey_msgs::{Header, Odometry, topics};
 
-    #[test]
-    fn each_topic_has_its_channel_and_the_hook_its_own() {
-        let prefix = format!("tfoxbridge{}_", std::process::id());
+    /// A test's own bus domain (its prefix, to retire), the bridge's taps on it, and the
+    /// latched store.
+    fn domain(tag: &str) -> (String, Bus, Vec<Box<dyn crate::taps::Tap>>, Arc<Latched>) {
+        let prefix = format!("{tag}{}_", std::process::id());
         let bus = Bus::join_with_prefix("foxglove-bridge-test", &prefix).expect("bus");
         let taps = crate::taps::open_all(&bus).expect("taps");
-        let latched = Arc::new(Latched::default());
+        (prefix, bus, taps, Arc::new(Latched::default()))
+    }
+
+    #[test]
+    fn each_topic_has_its_channel_and_the_hook_its_own() {
+        let (prefix, bus, taps, latched) = domain("tfoxbridge");
         let hook = Box::new(crate::derive::tests::Copy);
         let mut bridge = Bridge::new(&taps, hook, latched.clone()).expect("bridge");
         let topics: Vec<String> = bridge.channels.iter().map(|c| c.topic().to_owned()).collect();
@@ -199,10 +205,7 @@ mod tests {
 
     #[test]
     fn unwatched_frames_bring_their_calibration_without_being_encoded() {
-        let prefix = format!("tfoxframes{}_", std::process::id());
-        let bus = Bus::join_with_prefix("foxglove-bridge-test", &prefix).expect("bus");
-        let taps = crate::taps::open_all(&bus).expect("taps");
-        let latched = Arc::new(Latched::default());
+        let (prefix, bus, taps, latched) = domain("tfoxframes");
         let world = crate::derive::tests::world();
         let mut bridge =
             Bridge::new(&taps, crate::derive::hook(Some(&world)), latched.clone()).expect("bridge");
