@@ -2,28 +2,45 @@
 //! Expecter gave (002 §5.1, 001 §2: windowed, action-oriented perception): the one strong vertical
 //! edge in the window is the landmark, and its column gives the bearing through the calibration.
 //! No edge: "not found". Several edges of like strength: no answer (ambiguous), never a guess.
-//! An edge's strength is the mean absolute step across it over the window's rows above the
-//! window's own floor (the mean difference its estimated sensor noise alone gives), against a
-//! threshold lowered in a dim window: the same edge counts in a dim frame, a vignetted corner or under a
-//! passing cloud as in a bright one.
+//! An edge's strength is its step measured across a few columns (`span_px`, so that an edge a
+//! soft lens spreads over several columns counts whole) in bands of rows (`profile.rs`: noise
+//! averages out over a band instead of adding a floor of its own), less what noise alone gives.
+//! It must be a step, not a thin line, stand a few of its noise deviations clear (`z`) and pass
+//! a threshold lowered in a dim window: the same edge counts in a dim frame, a vignetted corner
+//! or under a passing cloud as in a bright one.
+
+mod profile;
 
 use harvey_msgs::{Expectation, FrameHeader, Header, LandmarkSighting, SightingKind};
 use harvey_vision::image::{Gray, Rect};
 use harvey_vision::noise::noise_sigma;
+
+use profile::Profile;
 
 /// Recognises class I landmarks; keeps its column profile between frames.
 #[derive(Debug)]
 pub struct LineLandmarks {
     /// Focal length in pixels at the frames' width.
     pub focal_px: f64,
-    /// Mean step (grey levels) above the window's floor for an edge to count; lowered in
-    /// proportion in a window darker than mid-grey (128).
+    /// Mean step (grey levels) for an edge to count; lowered in proportion in a window darker
+    /// than mid-grey (128).
     pub threshold: f32,
     /// The strongest edge must beat the second by this factor to be taken as the landmark.
     pub dominance: f32,
     /// Bearing error of a recognised edge, in pixels.
     pub sd_px: f64,
-    profile: Vec<f32>,
+    /// Columns a step is measured across: 1 for a sharp lens; a lens that blurs over a radius
+    /// of `r` pixels spreads an edge over `1 + 2 r` columns, which the step must take in whole
+    /// (`with_blur`). No wider, or the edges of a sign beside a corner add to it.
+    pub span_px: usize,
+    /// Rows per band of the profile: 8 average a pixel's noise down almost threefold and keep
+    /// a jamb's change of contrast at a lintel or a baseboard in bands of its own (of 4, 8 and
+    /// 16, the fewest wrong answers in `tests/landmarks_light.rs`).
+    pub band_rows: usize,
+    /// An edge's strength must be this many of its noise deviations (the window's sensor
+    /// noise averaged over a band, then over the bands) clear of zero.
+    pub z: f32,
+    profile: Profile,
     peaks: Vec<(usize, f32)>,
     seq: u64,
 }
@@ -45,7 +62,10 @@ impl LineLandmarks {
             threshold,
             dominance: 2.0,
             sd_px: 1.5,
-            profile: Vec::new(),
+            span_px: 1,
+            band_rows: 8,
+            z: 6.0,
+            profile: Profile::default(),
             peaks: Vec::new(),
             seq: 0,
         }
@@ -56,6 +76,12 @@ impl LineLandmarks {
     pub fn with_calibration_sd(self, calibration_sd_rad: f64) -> Self {
         let mount_px = self.focal_px * calibration_sd_rad;
         Self { sd_px: self.sd_px.hypot(mount_px), ..self }
+    }
+
+    /// The same recogniser for a lens of this blur radius (`[camera] blur_px`, the optics as
+    /// calibrated): steps measured across the columns it spreads an edge over.
+    pub fn with_blur(self, blur_px: u32) -> Self {
+        Self { span_px: 1 + 2 * blur_px as usize, ..self }
     }
 
     /// Looks for the landmark of `e` (class 1) in a mono8 or rgb8 frame. `None`: not a class I
@@ -71,47 +97,29 @@ impl LineLandmarks {
         }
         let [u0, v0, u1, v1] = e.window_px.map(|x| x.max(0.0) as usize);
         let (u1, v1) = (u1.min(w), v1.min(ht));
-        if u1 < u0 + 3 || v1 <= v0 {
+        let span = self.span_px.max(1);
+        if u1 < u0 + span + 2 || v1 <= v0 {
             return None;
         }
-        self.profile.clear();
-        self.profile.resize(u1 - u0 - 1, 0.0);
-        let mut brightness = 0u64;
-        for row in pixels.chunks_exact(stride).skip(v0).take(v1 - v0) {
-            for (k, acc) in self.profile.iter_mut().enumerate() {
-                let u = u0 + k;
-                *acc += f32::from(row[u * bpp].abs_diff(row[(u + 1) * bpp]));
-                brightness += u64::from(row[u * bpp]);
-            }
-        }
-        let rows = (v1 - v0) as f32;
-        let mean = brightness as f32 / (rows * self.profile.len() as f32);
-        // The window's own floor: the mean absolute difference sensor noise alone gives
-        // (2 sigma / sqrt(pi) for a noise of sigma per pixel), sigma estimated from the window
-        // (`harvey_vision::noise`; 0 in a clean frame). Mono frames; colour ones count from 0.
+        let (mean, band_rows) = self.profile.fill(pixels, stride, bpp, [u0, v0, u1, v1], self.band_rows);
+        // The window's sensor noise (`harvey_vision::noise`; 0 in a clean frame): a step between
+        // two columns' means over a band deviates by `band_sd`; its magnitude's mean is the
+        // floor noise alone gives, and the mean over the bands deviates by about `band_sd` over
+        // the root of their number. Mono frames; colour ones count from 0.
         let sigma = if bpp == 1 {
             Gray::new(pixels, w, ht, stride).map_or(0.0, |g| noise_sigma(&g, Rect::new(u0, v0, u1, v1)))
         } else {
             0.0
         };
-        let floor = rows * sigma * 2.0 / std::f32::consts::PI.sqrt();
-        for p in &mut self.profile {
-            *p = (*p - floor).max(0.0);
-        }
+        let band_sd = sigma * std::f32::consts::SQRT_2 / band_rows.sqrt();
+        let bands = ((v1 - v0) as f32 / band_rows).max(1.0);
+        self.profile.strengths(span, band_sd * std::f32::consts::FRAC_2_SQRT_PI / std::f32::consts::SQRT_2);
         // Dim windows count weaker edges (the same contrast at less light); bright ones never
         // need more than the threshold.
-        let threshold = self.threshold * (mean / 128.0).clamp(0.1, 1.0);
-        let p = &self.profile;
-        self.peaks.clear();
-        self.peaks.extend(
-            (0..p.len())
-                .filter(|&k| {
-                    p[k] / rows > threshold
-                        && (k == 0 || p[k] >= p[k - 1])
-                        && (k + 1 == p.len() || p[k] > p[k + 1])
-                })
-                .map(|k| (k, p[k] / rows)),
-        );
+        let noise = self.z * band_sd / bands.sqrt();
+        let threshold = (self.threshold * (mean / 128.0).clamp(0.1, 1.0)).max(noise);
+        // Every edge that could make the answer ambiguous, those under the threshold too.
+        self.find_peaks((threshold / self.dominance).max(noise), span);
         // Numbered only when sent, so that a gap in `seq` means a lost message.
         let header = Header::new(self.seq + 1, h.stamp_ns);
         let base = LandmarkSighting {
@@ -120,17 +128,17 @@ impl LineLandmarks {
             landmark_index: e.landmark_index,
             ..Default::default()
         };
-        let peaks = &self.peaks;
-        let best = peaks.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
-        let Some((k, strength)) = best else {
+        let best = self.peaks.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1));
+        let Some((k, strength)) = best.filter(|b| b.1 > threshold) else {
             self.seq += 1;
             return Some(LandmarkSighting { kind: SightingKind::NotFound as u32, ..base });
         };
-        if peaks.iter().any(|&(j, s)| j != k && s * self.dominance > strength) {
+        // Another edge of like strength, not the same one's plateau (a sharp edge is `span`
+        // columns wide in the profile): ambiguous.
+        if self.peaks.iter().any(|&(j, s)| j.abs_diff(k) > span && s * self.dominance > strength) {
             return None;
         }
-        // The edge lies on the boundary between columns u and u + 1.
-        let u_edge = (u0 + k + 1) as f64;
+        let u_edge = (u0 + 1) as f64 + self.profile.edge_at(k, span);
         let cx = w as f64 / 2.0;
         self.seq += 1;
         Some(LandmarkSighting {
@@ -139,6 +147,24 @@ impl LineLandmarks {
             a_sd: self.sd_px / self.focal_px,
             ..base
         })
+    }
+
+    /// The local maxima of the profile's strength over `floor` that are steps, not thin lines,
+    /// as (column, strength).
+    fn find_peaks(&mut self, floor: f32, span: usize) {
+        let (p, profile) = (&self.profile.strength, &self.profile);
+        self.peaks.clear();
+        self.peaks.extend(
+            (0..p.len())
+                .filter(|&k| {
+                    p[k] > floor
+                        && (k == 0 || p[k] >= p[k - 1])
+                        && (k + 1 == p.len() || p[k] > p[k + 1])
+                        && profile.is_step(k, span)
+                        && profile.coverage(k, span, (0.3 * p[k]).max(floor)) >= 0.5
+                })
+                .map(|k| (k, p[k])),
+        );
     }
 }
 
@@ -193,23 +219,59 @@ mod tests {
         assert!(r.recognise(&h, &frame(&[]), &other_size).is_none());
     }
 
+    /// `frame` with seeded noise of deviation `sd` added.
+    fn noisy(mut f: Vec<u8>, sd: f64, mut state: u64) -> Vec<u8> {
+        for p in &mut f {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let n = ((state & 0xff) as f64 + ((state >> 8) & 0xff) as f64) / 255.0 - 1.0; // sd 0.41
+            *p = (f64::from(*p) + n * sd / 0.41).round().clamp(0.0, 255.0) as u8;
+        }
+        f
+    }
+
+    /// The bearing of the boundary at column `u` of the test frames.
+    fn bearing(u: f64) -> f64 {
+        ((32.0 - u) / 55.4f64).atan()
+    }
+
     #[test]
     fn a_dim_noisy_edge_is_found_where_it_is() {
         // A 25-level step at column 40 of a dim frame (grey 60 to 85) under noise of sd 8:
         // the old mean absolute difference had a noise floor of 9 levels everywhere.
         let h = FrameHeader::new(1, 0, 64, 48, Encoding::Mono8);
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut noisy = frame(&[(0, 60), (40, 85)]);
-        for p in &mut noisy {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let n = ((state & 0xff) as f64 + ((state >> 8) & 0xff) as f64) / 255.0 - 1.0; // sd 0.41
-            *p = (f64::from(*p) + n * 8.0 / 0.41).round().clamp(0.0, 255.0) as u8;
-        }
+        let f = noisy(frame(&[(0, 60), (40, 85)]), 8.0, 0x2545_f491_4f6c_dd1d);
         let mut r = LineLandmarks::new(55.4, 12.0);
-        let s = r.recognise(&h, &noisy, &expect(30.0, 50.0)).expect("an answer");
+        let s = r.recognise(&h, &f, &expect(30.0, 50.0)).expect("an answer");
         assert_eq!(s.kind, SightingKind::Bearing as u32, "found, not ambiguous");
-        assert!((s.a - ((32.0 - 40.0) / 55.4f64).atan()).abs() < 1e-12, "{}", s.a);
+        assert!((s.a - bearing(40.0)).abs() < 0.25 / 55.4, "within a quarter pixel: {}", s.a);
+    }
+
+    #[test]
+    fn a_soft_noisy_edge_counts_whole() {
+        // The harsh condition's end-wall corner: a 36-level step spread over three columns by
+        // the lens (12 a column), noise of sd 8. Column by column, no step stands out of the
+        // noise's mean absolute difference (9 levels); across three columns it is whole.
+        let h = FrameHeader::new(1, 0, 64, 48, Encoding::Mono8);
+        for seed in [1u64, 2, 3, 4, 5] {
+            let f = noisy(frame(&[(0, 100), (39, 112), (40, 124), (41, 136)]), 8.0, 0x9e37_79b9 * seed);
+            let mut r = LineLandmarks::new(55.4, 12.0).with_blur(1);
+            let s = r.recognise(&h, &f, &expect(25.0, 55.0)).expect("an answer");
+            assert_eq!(s.kind, SightingKind::Bearing as u32, "seed {seed}");
+            // The ramp's middle step is the boundary at 40.
+            assert!((s.a - bearing(40.0)).abs() < 0.5 / 55.4, "seed {seed}: within half a pixel: {}", s.a);
+        }
+    }
+
+    #[test]
+    fn noise_alone_is_not_an_edge_however_low_the_threshold() {
+        let h = FrameHeader::new(1, 0, 64, 48, Encoding::Mono8);
+        for seed in [1u64, 2, 3, 4, 5, 6, 7, 8] {
+            let f = noisy(frame(&[(0, 120)]), 8.0, 0x51_7cc1_b727 * seed);
+            let mut r = LineLandmarks::new(55.4, 0.5);
+            let s = r.recognise(&h, &f, &expect(5.0, 60.0)).expect("an answer");
+            assert_eq!(s.kind, SightingKind::NotFound as u32, "seed {seed}");
+        }
     }
 }

@@ -140,7 +140,8 @@ fn main() -> anyhow::Result<()> {
 
     let mut edges = VerticalEdges::new(args.band_half_rows, args.edge_threshold);
     let mut lines = LineLandmarks::new(world.camera.focal_px, args.edge_threshold)
-        .with_calibration_sd(world.survey.calibration_sd_rad);
+        .with_calibration_sd(world.survey.calibration_sd_rad)
+        .with_blur(world.camera.blur_px);
     let mut wanted: BTreeMap<u32, Expectation> = BTreeMap::new();
     if resume.resumed() {
         let kept = resume.state();

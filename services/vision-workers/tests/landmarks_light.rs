@@ -1,0 +1,146 @@
+//! Class I landmarks (door jambs, the end wall's corner) under the sweep's sensor conditions
+//! (`conditions/*.toml`: nominal, dim, harsh), on rendered hallway frames with the camera's
+//! noise, vignetting and blur: the recogniser (`landmarks::LineLandmarks`) is given the window
+//! an Expecter would give round the landmark's true column, from poses along the hall, and its
+//! answers are judged against that column. Counted: right (within 1.5 px), wrong (another
+//! edge: the blunders the UMS must refuse) and silent (not found or ambiguous). Prints the
+//! table `docs/evaluation.md` quotes.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
+
+use harvey_msgs::{Encoding, Expectation, FrameHeader, Pose2, SightingKind};
+use harvey_render::{Effects, Renderer};
+use harvey_vision_workers::landmarks::LineLandmarks;
+use harvey_world::{LandmarkClass, World};
+
+/// (name, illumination, noise sd, vignetting, blur px), as `conditions/` sets the camera.
+const CONDITIONS: [(&str, f64, f64, f64, u32); 3] =
+    [("nominal", 220.0, 3.0, 0.2, 0), ("dim", 170.0, 5.0, 0.25, 0), ("harsh", 170.0, 8.0, 0.35, 1)];
+
+#[derive(Debug, Default)]
+struct Tally {
+    asked: usize,
+    right: usize,
+    wrong: usize,
+}
+
+fn world() -> World {
+    harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
+}
+
+/// Nothing stands between the camera and the landmark's foot at mid-height.
+fn unhidden(w: &World, pose: Pose2, at: [f64; 2]) -> bool {
+    let (dx, dy) = (at[0] - pose.x_m, at[1] - pose.y_m);
+    let d = dx.hypot(dy);
+    w.cast_ray([pose.x_m, pose.y_m], [dx / d, dy / d], d).is_none_or(|h| h.distance_m > d - 0.05)
+}
+
+/// Looks down the hall from poses along it, each class I landmark in view searched for in a
+/// window from `window_px[0]` to `window_px[1]` columns from its true one.
+fn tally(condition: (&str, f64, f64, f64, u32), seed: u64, window_px: [f64; 2]) -> Tally {
+    let (_, light, noise, vignetting, blur) = condition;
+    let mut w = world();
+    (w.camera.illumination, w.camera.noise_sd, w.camera.vignetting, w.camera.blur_px) =
+        (light, noise, vignetting, blur);
+    w.camera.misalignment_sd_rad = 0.0;
+    let (width, height) = (640u32, 480u32);
+    let mut r = Renderer::new(&w, width, height, Encoding::Mono8);
+    let fx = Effects::from_camera(&w.camera, seed);
+    let mut px = vec![0u8; r.frame_bytes()];
+    let mut lines = LineLandmarks::new(w.camera.focal_px, 12.0).with_blur(blur);
+    let mut t = Tally::default();
+    let mut seq = 0;
+    for x in [-0.5, 0.5, 1.5, 2.5, 3.5, 5.5, 6.5, 7.5, 8.5, 9.5] {
+        for y in [-0.4, 0.0, 0.4] {
+            for deg in [-8.0, 0.0, 8.0] {
+                seq += 1;
+                let pose = Pose2::new(x, y, f64::to_radians(deg));
+                r.render(&w, pose, &mut px).expect("renders");
+                fx.apply(width as usize, height as usize, 1, seq, &mut px);
+                let h = FrameHeader::new(seq, seq * 100_000_000, width, height, Encoding::Mono8);
+                for (i, l) in w.landmarks.iter().enumerate().filter(|(_, l)| l.class == LandmarkClass::I) {
+                    let [lx, ly, lz] = l.position_m;
+                    let (foot, head) = (
+                        w.camera.project(width, height, pose, [lx, ly, lz]),
+                        w.camera.project(width, height, pose, [lx, ly, lz + l.height_m]),
+                    );
+                    let (Some(foot), Some(head)) = (foot, head) else { continue };
+                    let range = (lx - x).hypot(ly - y);
+                    if !(40.0..600.0).contains(&foot[0])
+                        || range > l.activation_range_m
+                        || !unhidden(&w, pose, [lx, ly])
+                    {
+                        continue;
+                    }
+                    let e = Expectation {
+                        landmark_index: i as u32,
+                        class: 1,
+                        window_px: [
+                            (foot[0] + window_px[0]) as f32,
+                            head[1].max(0.0) as f32,
+                            (foot[0] + window_px[1]) as f32,
+                            foot[1].min(f64::from(height)) as f32,
+                        ],
+                        width_px: width,
+                        height_px: height,
+                        ..Default::default()
+                    };
+                    t.asked += 1;
+                    let Some(s) = lines.recognise(&h, &px, &e) else { continue };
+                    if s.kind != SightingKind::Bearing as u32 {
+                        continue;
+                    }
+                    let seen = f64::from(width) / 2.0 - w.camera.focal_px * s.a.tan();
+                    if (seen - foot[0]).abs() <= 1.5 { t.right += 1 } else { t.wrong += 1 }
+                }
+            }
+        }
+    }
+    t
+}
+
+#[test]
+fn the_landmarks_are_found_where_they_are_whatever_the_light() {
+    println!("| condition | window (px from the landmark) | asked | right | wrong | silent |");
+    println!("|---|---|---:|---:|---:|---:|");
+    for c in CONDITIONS {
+        // Centred on the landmark, narrow and wide; then beside it, the landmark outside (a
+        // map that is off): every answer there is another edge.
+        for window in [[-15.0, 15.0], [-30.0, 30.0], [6.0, 36.0], [-36.0, -6.0]] {
+            let mut all = Tally::default();
+            for seed in [1, 2] {
+                let t = tally(c, seed, window);
+                (all.asked, all.right, all.wrong) =
+                    (all.asked + t.asked, all.right + t.right, all.wrong + t.wrong);
+            }
+            let pct = |n: usize| 100.0 * n as f64 / all.asked.max(1) as f64;
+            println!(
+                "| {} | {:+} to {:+} | {} | {:.1} % | {:.1} % | {:.1} % |",
+                c.0,
+                window[0],
+                window[1],
+                all.asked,
+                pct(all.right),
+                pct(all.wrong),
+                pct(all.asked - all.right - all.wrong)
+            );
+            assert!(all.asked >= 100, "{}: too few landmarks in view ({})", c.0, all.asked);
+            let centred = window[0] < 0.0 && window[1] > 0.0;
+            if centred {
+                assert!(
+                    pct(all.right) >= 50.0,
+                    "{} {window:?}: found where they are {:.1} %",
+                    c.0,
+                    pct(all.right)
+                );
+                assert!(pct(all.wrong) <= 3.0, "{} {window:?}: wrong answers {:.1} %", c.0, pct(all.wrong));
+            } else {
+                assert!(
+                    pct(all.wrong) <= 30.0,
+                    "{} {window:?}: another edge taken {:.1} %",
+                    c.0,
+                    pct(all.wrong)
+                );
+            }
+        }
+    }
+}
