@@ -6,14 +6,16 @@ usage: check_rrd.py RUN.rrd [--same-as OTHER.rrd] [--need ENTITY]... [--say ENTI
 - every entity the view is built on is there (the camera image, the world view round the robot
   and the whole world, the paths, one plot subtree per quantity, the log and the state lanes),
   and each --need entity too;
-- the log is a log, not a per-tick stream: over 100 ticks or more, its lines are fewer than a
-  tenth of the true poses;
+- the log is a log, not a per-tick stream: over 100 ticks or more, its lines are fewer than half
+  the true poses, and no one line (its numbers aside) recurs on a twentieth of the ticks or more
+  (a warning raised each frame; an eventful mission may log often, but not the same thing);
 - each --say: a line of the log entity ENTITY contains TEXT, at level WARN or ERROR (a service's
   own warning brought in from `rosout`);
 - with --same-as, both files draw the same entities, but for the loop latency (wall clock, drawn
   only by the live recorder): `harvey export` draws what the recorder drew live.
 """
 import argparse
+import re
 import sys
 from collections import Counter
 
@@ -35,8 +37,8 @@ def rows(path):
     return counts
 
 
-def warnings(path):
-    """(entity, level, text) of every WARN or ERROR line of the log."""
+def log_lines(path):
+    """(entity, level, text) of every line of the log."""
     out = []
     for chunk in rr.experimental.RrdReader(path).stream().to_chunks():
         entity = str(chunk.entity_path)
@@ -49,8 +51,7 @@ def warnings(path):
         levels = batch.column("TextLog:level").to_pylist()
         for text, level in zip(texts, levels):
             for t, l in zip(text or [], level or []):
-                if l in ("WARN", "ERROR"):
-                    out.append((entity, l, t))
+                out.append((entity, l, t))
     return out
 
 
@@ -63,11 +64,15 @@ def main():
     a = ap.parse_args()
     counts = rows(a.rrd)
     problems = [f"{a.rrd}: no entity {e}" for e in ALWAYS + a.need if counts[e] == 0]
-    log_lines = sum(n for e, n in counts.items() if e.startswith("/log/"))
+    lines = log_lines(a.rrd)
     truths = counts["/world/robot/truth"]
-    if truths >= 100 and log_lines * 10 >= truths:
-        problems.append(f"{a.rrd}: {log_lines} log lines for {truths} true poses: the log repeats per tick")
-    said = warnings(a.rrd) if a.say else []
+    if truths >= 100 and len(lines) * 2 >= truths:
+        problems.append(f"{a.rrd}: {len(lines)} log lines for {truths} true poses: the log repeats per tick")
+    alike = Counter((e, re.sub(r"[0-9.]+", "#", t)) for e, _, t in lines)
+    for (e, t), n in alike.most_common(1):
+        if truths >= 100 and n * 20 >= truths:
+            problems.append(f"{a.rrd}: {e} says {t!r} {n} times in {truths} ticks: a warning raised per tick")
+    said = [(e, l, t) for e, l, t in lines if l in ("WARN", "ERROR")]
     for want in a.say:
         entity, _, text = want.partition("=")
         if not any(e == entity and text in t for e, _, t in said):
@@ -83,7 +88,7 @@ def main():
         print(p, file=sys.stderr)
     if problems:
         sys.exit(1)
-    print(f"{a.rrd}: {len(counts)} entities, {log_lines} log lines for {truths} true poses"
+    print(f"{a.rrd}: {len(counts)} entities, {len(lines)} log lines for {truths} true poses"
           + (f", the same entities as {a.same_as}" if a.same_as else ""))
 
 

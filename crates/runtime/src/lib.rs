@@ -1,6 +1,6 @@
 //! What every Harvey service process shares: logging set-up, the readiness handshake with
 //! the supervisor, [`checkpoint`]s of a service's state across restarts, and its warnings on
-//! `rosout` ([`rosout`]).
+//! `rosout` ([`rosout`]), repeated ones said once a period ([`throttle`]).
 //!
 //! Readiness: the supervisor passes a pipe's write end in `$HARVEY_READY_FD`; a service calls
 //! [`notify_ready`] once its ports exist, which writes `READY\n` and closes the pipe. A service
@@ -10,11 +10,13 @@ pub mod checkpoint;
 pub mod journal;
 pub mod resume;
 pub mod rosout;
+pub mod throttle;
 
 pub use checkpoint::{Checkpoint, CheckpointError, STATE_DIR_ENV};
 pub use journal::Journal;
 pub use resume::{Marks, Resume, Sent};
 pub use rosout::Rosout;
+pub use throttle::{Say, Throttle};
 
 use std::io::Write;
 use std::os::fd::FromRawFd;

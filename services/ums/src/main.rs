@@ -6,7 +6,7 @@ use std::path::PathBuf;
 use clap::Parser;
 use harvey_bus::{Bus, Pace, Step, Waiter};
 use harvey_msgs::topics;
-use harvey_runtime::{Rosout, Sent};
+use harvey_runtime::{Rosout, Sent, Throttle};
 use harvey_ums::{Config, Output, Ums};
 
 #[derive(Parser)]
@@ -37,6 +37,10 @@ struct Args {
     /// How late a sighting may arrive and still be applied at its own stamp.
     #[arg(long, default_value_t = 2000)]
     history_ms: u64,
+    /// A refusal repeated (the same landmark, the same reason) is logged at most once in this
+    /// many seconds of message time, with its count.
+    #[arg(long, default_value_t = 5.0)]
+    repeat_warning_s: f64,
 }
 
 /// Sends `m` unless a predecessor of this process sent it before it was killed.
@@ -53,6 +57,13 @@ fn send<T: harvey_msgs::Message>(
     Ok(())
 }
 
+/// Logs a refusal, unless the same one was logged less than a period ago.
+fn warn(throttle: &mut Throttle, e: &dyn std::fmt::Display, stamp_ns: u64) {
+    if let Some(said) = throttle.raise(e.to_string(), stamp_ns) {
+        tracing::warn!("rejected: {said}");
+    }
+}
+
 /// Room for the map, its history and the pending sightings.
 const SLOT_BYTES: usize = 1 << 20;
 
@@ -62,6 +73,11 @@ fn main() -> anyhow::Result<()> {
     anyhow::ensure!(
         args.sigmas > 0.0 && args.lost_area_m2 > 0.0,
         "--sigmas and --lost-area-m2 must be positive"
+    );
+    anyhow::ensure!(
+        args.repeat_warning_s.is_finite() && args.repeat_warning_s >= 0.0,
+        "--repeat-warning-s must be a duration in seconds, not {}",
+        args.repeat_warning_s
     );
     let mut world = harvey_world::World::load(&args.world)?;
     if let Some(start) = args.start {
@@ -90,16 +106,19 @@ fn main() -> anyhow::Result<()> {
     harvey_runtime::notify_ready()?;
 
     let mut ums = Ums::new(world, config);
-    // The uncertainty as the last finished tick left it, for a restarted UMS.
-    let mut resume = harvey_runtime::Resume::from_env("ums", SLOT_BYTES, || ums.state())?;
+    // The uncertainty and the warnings held back as the last finished tick left them, for a
+    // restarted UMS.
+    let throttle = Throttle::new((args.repeat_warning_s * 1e9) as u64);
+    let mut resume = harvey_runtime::Resume::from_env("ums", SLOT_BYTES, || (ums.state(), throttle))?;
     let mut sent = Sent::from_env("ums")?;
     if resume.resumed() {
-        ums.restore(resume.state().clone());
+        ums.restore(resume.state().0.clone());
         tracing::warn!(
             area_m2 = harvey_ums::geometry::area(&ums.map().polygon),
             "resumed from the checkpoint"
         );
     }
+    let mut warnings = resume.state().1.clone();
     let (mut odos, mut seen, mut fixed) = (Vec::new(), Vec::new(), Vec::new());
     let mut newest = 0;
     while let Step::Go(tick) = pace.next(&waiter, None)? {
@@ -108,14 +127,14 @@ fn main() -> anyhow::Result<()> {
         seen.retain(|m| resume.fresh(sightings.topic(), m.header.stamp_ns, m.header.seq));
         for s in &seen {
             if let Err(e) = ums.on_sighting(s) {
-                tracing::warn!("rejected: {e}");
+                warn(&mut warnings, &e, s.header.stamp_ns);
             }
         }
         fixes.drain_into(&mut fixed)?;
         fixed.retain(|m| resume.fresh(fixes.topic(), m.header.stamp_ns, m.header.seq));
         for f in &fixed {
             if let Err(e) = ums.on_fix(f) {
-                tracing::warn!("rejected: {e}");
+                warn(&mut warnings, &e, f.header.stamp_ns);
             }
         }
         odometry.drain_into(&mut odos)?;
@@ -128,15 +147,19 @@ fn main() -> anyhow::Result<()> {
                         match x {
                             Output::Map(m) => send(&mut sent, &map_pub, &m)?,
                             Output::Expectation(e) => send(&mut sent, &expectations, &e)?,
-                            Output::Rejected(e) => tracing::warn!("rejected: {e}"),
+                            Output::Rejected(e) => warn(&mut warnings, &e, o.header.stamp_ns),
                         }
                     }
                 }
-                Err(e) => tracing::warn!("rejected: {e}"),
+                Err(e) => warn(&mut warnings, &e, o.header.stamp_ns),
             }
         }
-        rosout.end(tick.unwrap_or(newest))?;
-        *resume.state() = ums.state();
+        let now = tick.unwrap_or(newest);
+        for said in warnings.expire(now) {
+            tracing::warn!("rejected: {said}");
+        }
+        rosout.end(now)?;
+        *resume.state() = (ums.state(), warnings.clone());
         resume.tick_done()?;
         pace.done()?;
     }
