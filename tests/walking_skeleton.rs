@@ -86,8 +86,10 @@ fn the_default_mission_runs_records_and_cleans_up() {
     // The sonar reflexes speak only when something is in the way (tests/panic_avoid.rs), the
     // servoing only on servoed moves and refinements (tests/hallway.rs, tests/pose_refine.rs),
     // plan-and-monitor and the acceptor-sequenced behaviours only in their missions
-    // (tests/ptrans.rs, tests/docking.rs).
+    // (tests/ptrans.rs, tests/docking.rs); the services warn on rosout only when something
+    // goes wrong, which a clean default run need not (tests/rosout.rs).
     let eventful = [
+        topics::ROSOUT.name,
         topics::VEHICLE_REFLEX.name,
         topics::EXECUTIVE_SERVO.name,
         topics::EXECUTIVE_POSE.name,

@@ -23,7 +23,9 @@ pub fn implausible(world: &World, map: &Map, s: &LandmarkSighting, sigmas: f64) 
     let d = dx.hypot(dy).max(0.1);
     let predicted = harvey_geometry::wrap(dy.atan2(dx) - map.heading_rad);
     let innovation = harvey_geometry::wrap(s.a - predicted);
-    let wedge = if innovation > 0.0 { map.ccw_rad } else { map.cw_rad };
+    // A heading further counter-clockwise turns every bearing clockwise: a bearing short of
+    // the prediction is what the wedge's counter-clockwise side explains, and the other way on.
+    let wedge = if innovation < 0.0 { map.ccw_rad } else { map.cw_rad };
     let spread = s.a_sd.hypot(world.landmark_sd_m(l) / d);
     innovation.abs() > sigmas * spread + wedge + radius(map) / d
 }
@@ -109,7 +111,17 @@ mod tests {
         assert!(implausible(&w, &known, &frame[2], 3.0));
         assert!(!implausible(&w, &known, &frame[1], 3.0));
         // A wide wedge (a long turn) lets more through.
-        let turned = Map { cw_rad: 0.06, ccw_rad: 0.06, ..known };
+        let turned = Map { cw_rad: 0.06, ccw_rad: 0.06, ..known.clone() };
         assert!(!implausible(&w, &turned, &frame[2], 3.0));
+        // A lopsided wedge lets through only the bearings its wide side explains: the robot
+        // may be turned up to 60 mrad counter-clockwise, which puts the corner 40 mrad
+        // clockwise of (short of) where the wedge's heading sees it, not 40 mrad beyond.
+        let lopsided = Map { cw_rad: 0.001, ccw_rad: 0.06, ..known.clone() };
+        let short = LandmarkSighting { a: frame[2].a - 0.080, ..frame[2] };
+        assert!(!implausible(&w, &lopsided, &short, 3.0));
+        assert!(implausible(&w, &lopsided, &frame[2], 3.0));
+        let mirrored = Map { cw_rad: 0.06, ccw_rad: 0.001, ..known };
+        assert!(implausible(&w, &mirrored, &short, 3.0));
+        assert!(!implausible(&w, &mirrored, &frame[2], 3.0));
     }
 }

@@ -167,13 +167,19 @@ impl Ums {
         for frame in due.chunk_by(|a, b| a.header.stamp_ns == b.header.stamp_ns) {
             let blunders = consensus::outliers(&self.world, &self.map, frame, self.config.sigmas);
             for (i, s) in frame.iter().enumerate() {
-                let outcome = if blunders.contains(&i)
-                    || consensus::implausible(&self.world, &self.map, s, self.config.sigmas)
-                {
-                    let landmark = self.world.landmarks[s.landmark_index as usize].name.clone();
-                    Err(SightingError::Rejected { landmark, why: reduction::Rejection::Disagrees })
+                let why = if blunders.contains(&i) {
+                    Some(reduction::Rejection::Disagrees)
+                } else if consensus::implausible(&self.world, &self.map, s, self.config.sigmas) {
+                    Some(reduction::Rejection::Implausible)
                 } else {
-                    self.apply_sighting(s)
+                    None
+                };
+                let outcome = match why {
+                    Some(why) => {
+                        let landmark = self.world.landmarks[s.landmark_index as usize].name.clone();
+                        Err(SightingError::Rejected { landmark, why })
+                    }
+                    None => self.apply_sighting(s),
                 };
                 rejected.extend(outcome.err().map(Output::Rejected));
             }

@@ -44,6 +44,9 @@ pub enum Rejection {
     /// `consensus.rs`: the frame's other sightings imply another heading.
     #[error("the other landmarks seen in the same frame disagree with it: a false match")]
     Disagrees,
+    /// `consensus.rs`: the bearing is further from the map's prediction than its spread allows.
+    #[error("its bearing is further from the map's prediction than the map's spread allows: a false match")]
+    Implausible,
 }
 
 /// Keeps the side of the line through `o` along `d` to its left, widened by `margin`.
