@@ -6,10 +6,12 @@
 //! It prints the CPU model, its SIMD features and the instruction-set path each row ran
 //! (`HARVEY_SIMD=portable|avx2|avx512` lowers it, never past what the CPU has).
 //!
-//! `taskset -c 0 cargo bench -p harvey-vision --bench kernels`
+//! `taskset -c 0 cargo bench -p harvey-vision --bench kernels`; with `-- paths`, only the
+//! correlation rows on every path the CPU has, against each other in one run (`paths.rs`).
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 mod geometry;
+mod paths;
 mod reference;
 mod reference_geometry;
 #[path = "../tests/common/sidewalk.rs"]
@@ -328,6 +330,11 @@ fn main() {
         simd::ENV,
         std::env::var(simd::ENV).ok()
     );
+    if std::env::args().any(|a| a == "paths") {
+        let img = frame(&world, 640, 480);
+        paths::compare(&img.view(), "640x480");
+        return;
+    }
     let mut rows = Vec::new();
     for (w, h) in [(640u32, 480u32), (256, 256)] {
         let img = frame(&world, w, h);

@@ -1,8 +1,9 @@
 //! The correlation cross-sum `Σ P (T - 128)` for every placement, on each [`Path`]: AVX-512
 //! VNNI (`vpdpbusd`, 64 byte products an instruction), AVX2 (`vpmaddwd` on zero-extended pixel
 //! pairs, exact: no 16-bit saturation), NEON (`smlal`, pixels widened to 16 bits and multiplied
-//! into 32-bit sums), and a portable loop. All are exact integer sums, so they agree bit for
-//! bit; `nc.rs` calls [`cross`].
+//! into 32-bit sums), and portable Rust (`cross/portable.rs`, which LLVM turns into `pmaddwd`
+//! on baseline x86-64). All are exact integer sums, so they agree bit for bit; `nc.rs` calls
+//! [`cross`].
 //!
 //! Layout (shared with `nc.rs`): `pad` holds the window's rows, `pw` bytes apart, padded with
 //! zeros so whole blocks can be read past the last placement; `out` has a row stride of `nx`
@@ -14,6 +15,9 @@ use core::arch::aarch64::*;
 use core::arch::x86_64::*;
 
 use crate::simd::Path;
+
+mod portable;
+use portable::{Wide, cross_portable, widen};
 
 /// Placements per block along a row.
 pub(crate) const BLOCK_X: usize = 16;
@@ -31,6 +35,9 @@ pub(crate) struct Packed {
     pub(crate) pairs: Vec<i32>,
     /// Pairs per row.
     pub(crate) npairs: usize,
+    /// Each pair replicated over eight placements' lanes, column by column, for the portable
+    /// kernel (`cross/portable.rs`).
+    pub(crate) wide: Vec<Wide>,
     /// Template rows.
     pub(crate) rows: usize,
 }
@@ -50,6 +57,7 @@ impl Packed {
                 self.pairs[y * npairs + x / 2] |= i32::from(v as i16 as u16) << (16 * (x % 2));
             }
         }
+        widen(&self.pairs, npairs, h, &mut self.wide);
         (self.groups, self.npairs, self.rows) = (groups, npairs, h);
     }
 }
@@ -210,32 +218,6 @@ unsafe fn cross_neon(pad: &[u8], pw: usize, nx: usize, t: &Packed, blocks: &[u32
                 // SAFETY: within `out` by the size contract.
                 unsafe { vst1q_s32(out.as_mut_ptr().add((y0 + j) * stride + xb + 4 * k), *v) };
             }
-        }
-    }
-}
-
-/// The portable form, a block at a time: for each template pixel, the block's 16 placements
-/// of a row add `p t` as a 16-bit product (`|p t| <= 255 x 128` fits an i16, so it vectorises
-/// as `pmullw` on any x86-64, or as NEON multiplies) widened into the i32 sums.
-pub(crate) fn cross_portable(pad: &[u8], pw: usize, nx: usize, t: &Packed, blocks: &[u32], out: &mut [i32]) {
-    let stride = nx.next_multiple_of(BLOCK_X);
-    for (y0, xb) in blocks.iter().map(|&b| origin(b as usize, nx)) {
-        for y in y0..y0 + BLOCK_Y {
-            let mut acc = [0i32; BLOCK_X];
-            for r in 0..t.rows {
-                let row = &pad[(y + r) * pw + xb..];
-                for (q, &word) in t.pairs[r * t.npairs..(r + 1) * t.npairs].iter().enumerate() {
-                    for (c, tv) in [(2 * q, word as i16), (2 * q + 1, (word >> 16) as i16)] {
-                        if tv == 0 {
-                            continue;
-                        }
-                        for (o, &p) in acc.iter_mut().zip(&row[c..c + BLOCK_X]) {
-                            *o += i32::from(i16::from(p) * tv);
-                        }
-                    }
-                }
-            }
-            out[y * stride + xb..][..BLOCK_X].copy_from_slice(&acc);
         }
     }
 }
