@@ -98,7 +98,8 @@ fn group(
     for (yy, row) in (g0..).zip(strip) {
         let Some(Ok(px)) = row.get(at..at + 2 * HALF).map(<&Half>::try_from) else { continue };
         for (j, a) in [&mut a0, &mut a1, &mut a2, &mut a3].into_iter().enumerate() {
-            if let Some(t) = yy.checked_sub(j).and_then(|r| col.get(r)) {
+            // Below row 0, `yy - j` wraps to an index past the end: one comparison for both.
+            if let Some(t) = col.get(yy.wrapping_sub(j)) {
                 madd(a, px, t);
             }
         }
