@@ -7,7 +7,8 @@
 //! (`HARVEY_SIMD=portable|avx2|avx512` lowers it, never past what the CPU has).
 //!
 //! `taskset -c 0 cargo bench -p harvey-vision --bench kernels`; with `-- paths`, only the
-//! correlation rows on every path the CPU has, against each other in one run (`paths.rs`).
+//! correlation and Moravec rows on every path the CPU has, against each other in one run
+//! (`paths.rs`).
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 mod geometry;
@@ -332,7 +333,10 @@ fn main() {
     );
     if std::env::args().any(|a| a == "paths") {
         let img = frame(&world, 640, 480);
-        paths::compare(&img.view(), "640x480");
+        if !std::env::args().any(|a| a == "moravec") {
+            paths::compare(&img.view(), "640x480");
+        }
+        paths::compare_moravec(&img.view(), "640x480");
         return;
     }
     let mut rows = Vec::new();

@@ -21,6 +21,10 @@ pub(super) trait RowSink {
 #[derive(Debug, Default)]
 pub(super) struct Columns {
     sums: Vec<u32>,
+    /// The portable path's squares (16 bits) of the last `k` rows per shift, row `r` in slot
+    /// `r % k` (shift `d`'s at `d * k`), and of the row entering the window.
+    ring: Vec<Vec<u16>>,
+    enter: Vec<u16>,
 }
 
 /// The margin (pixels) of a `k x k` window where the interest is not defined (it is 0 there):
@@ -46,7 +50,7 @@ pub(super) fn interest_rows(
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
         Path::Avx2 => unsafe { rows_avx2(img, w, k, cols, sink) },
-        _ => rows(img, w, k, cols, sink),
+        _ => rows::<true>(img, w, k, cols, sink),
     }
 }
 
@@ -56,7 +60,7 @@ pub(super) fn interest_rows(
 /// The CPU must have the features of [`Path::Avx512`].
 #[multiversion::target("x86_64+avx2+fma+bmi2+avx512f+avx512bw+avx512vnni")]
 unsafe fn rows_avx512(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
-    rows(img, w, k, cols, sink)
+    rows::<false>(img, w, k, cols, sink)
 }
 
 /// [`rows`] compiled for AVX2.
@@ -65,14 +69,20 @@ unsafe fn rows_avx512(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sin
 /// The CPU must have the features of [`Path::Avx2`].
 #[multiversion::target("x86_64+avx2+fma+bmi2")]
 unsafe fn rows_avx2(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
-    rows(img, w, k, cols, sink)
+    rows::<false>(img, w, k, cols, sink)
 }
 
 /// `(p - q)²`: at most 255², which fits 16 bits, so it is formed in 16-bit lanes.
 #[inline(always)]
-fn sq(p: u8, q: u8) -> u32 {
+fn sq16(p: u8, q: u8) -> u16 {
     let d = i16::from(p) - i16::from(q);
-    u32::from(d.wrapping_mul(d) as u16)
+    d.wrapping_mul(d) as u16
+}
+
+/// [`sq16`] widened for a sum.
+#[inline(always)]
+fn sq(p: u8, q: u8) -> u32 {
+    u32::from(sq16(p, q))
 }
 
 /// Image row `y` and the same row shifted by `(dx, dy)`, columns `x0 .. x0 + n`.
@@ -84,7 +94,7 @@ fn pair<'a>(img: &Gray<'a>, y: usize, x0: usize, n: usize, (dx, dy): (isize, isi
 }
 
 #[inline(always)]
-fn rows(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
+fn rows<const STAGED: bool>(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
     let (ww, wh, h, mg) = (w.width(), w.height(), k / 2, margin(k));
     if ww <= 2 * mg || wh <= 2 * mg {
         for y in 0..wh {
@@ -98,6 +108,9 @@ fn rows(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl R
     let m = n - 2 * h;
     cols.sums.clear();
     cols.sums.resize(SHIFTS.len() * n, 0);
+    if STAGED {
+        cols.ring.resize_with(SHIFTS.len() * k, Vec::new);
+    }
     let top = 1; // the first row a window covers (row 0 is read by the up-right shift)
     for y in 0..mg {
         sink.row(y).fill(0);
@@ -116,7 +129,23 @@ fn rows(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl R
                     for ((s, &p), &q) in c.iter_mut().zip(a).zip(b) {
                         *s += sq(p, q);
                     }
+                    if STAGED {
+                        let slot = &mut cols.ring[d * k + r % k];
+                        slot.clear();
+                        slot.extend(a.iter().zip(b).map(|(&p, &q)| sq16(p, q)));
+                    }
                 }
+            } else if STAGED {
+                // The row leaving the window (y - h - 1) is k rows above the one entering it
+                // (y + h): its squares are in the slot the entering row's take.
+                let (a, b) = pair(img, w.y0 + y + h, x0, n, shift);
+                cols.enter.clear();
+                cols.enter.extend(a.iter().zip(b).map(|(&p, &q)| sq16(p, q)));
+                let slot = &mut cols.ring[d * k + (y + h) % k];
+                for ((s, &p), &q) in c.iter_mut().zip(&cols.enter).zip(slot.iter()) {
+                    *s = s.wrapping_add(u32::from(p)).wrapping_sub(u32::from(q));
+                }
+                std::mem::swap(slot, &mut cols.enter);
             } else {
                 let (a, b) = pair(img, w.y0 + y + h, x0, n, shift);
                 let (e, f) = pair(img, w.y0 + y - h - 1, x0, n, shift);
@@ -146,15 +175,17 @@ fn across<const K: usize>(sums: &[u32], n: usize, out: &mut [u32]) {
     let m = out.len();
     let taps: [[&[u32]; K]; 4] = std::array::from_fn(|d| std::array::from_fn(|j| &sums[d * n + j..][..m]));
     for (x, o) in out.iter_mut().enumerate() {
-        let mut best = u32::MAX;
+        // A window sum is at most 81 * 255² (23 bits), so the least is taken as `i32`: SSE2
+        // compares signed 32-bit lanes (`pcmpgtd`) but not unsigned ones.
+        let mut best = i32::MAX;
         for shift in &taps {
             let mut s = 0u32;
             for t in shift {
                 s += t[x];
             }
-            best = best.min(s);
+            best = best.min(s as i32);
         }
-        *o = best;
+        *o = best as u32;
     }
 }
 
