@@ -71,13 +71,17 @@ impl Script {
                 vec![self.send(step, CommandKind::Turn, 0.0, a, now)]
             }
             LegStep::Look(expected) => {
-                let (Some(s), Some(sv)) = (self.leg.as_ref().and_then(|l| l.servo), self.servo_table) else {
+                let (Some(l), Some(sv)) = (self.leg.as_ref(), self.servo_table) else {
                     return Vec::new();
                 };
+                let Some(s) = l.servo else { return Vec::new() };
+                // Searched only where a sighting the leg would accept can be.
+                let window =
+                    super::window::look_window(&s, expected, l.mount_rad, l.offset_m, sv.template_px);
                 let request = self.next_request;
                 self.next_request += 1;
                 self.phase = Phase::Looking { step, request };
-                vec![Output::Look(VisionRequest::correlate(
+                let mut look = VisionRequest::correlate(
                     request,
                     now,
                     s.landmark_index,
@@ -85,7 +89,11 @@ impl Script {
                     s.offset,
                     sv.template_px,
                     sv.min_score,
-                ))]
+                );
+                if let Some(w) = window {
+                    look.window_px = w;
+                }
+                vec![Output::Look(look)]
             }
             LegStep::Done => {
                 if let Some(l) = self.leg.take() {
