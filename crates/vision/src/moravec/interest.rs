@@ -1,7 +1,8 @@
 //! The Moravec interest rows: for each of the four shifts the squared differences are summed
 //! down a `k`-row column (a sliding sum: the row entering the window is added and the row
-//! leaving it taken away, both recomputed from the image), then across `k` columns; the interest
-//! is the smallest of the four. Rows stream out one at a time to a [`RowSink`], so the whole
+//! leaving it taken away, both recomputed from the image on the AVX paths; the portable path
+//! keeps each row's squares in a ring instead), then across `k` columns; the interest is the
+//! smallest of the four. Rows stream out one at a time to a [`RowSink`], so the whole
 //! pass runs in the first-level cache.
 
 use crate::image::{Gray, Rect};
@@ -93,6 +94,12 @@ fn pair<'a>(img: &Gray<'a>, y: usize, x0: usize, n: usize, (dx, dy): (isize, isi
     (a, b)
 }
 
+/// The interest rows. `STAGED` (the portable path): each row's squares are formed in a loop of
+/// their own, as 16-bit values, and kept in a ring of the last `k` rows per shift, so the row
+/// leaving the window is not squared again. In one loop with the 32-bit sums LLVM widened four
+/// pixels at a time at the SSE2 baseline, each 16-bit multiply filling half a register; on their
+/// own the squares are formed eight to a register. The AVX paths keep the one loop (the ring
+/// has not been measured there).
 #[inline(always)]
 fn rows<const STAGED: bool>(img: &Gray<'_>, w: Rect, k: usize, cols: &mut Columns, sink: &mut impl RowSink) {
     let (ww, wh, h, mg) = (w.width(), w.height(), k / 2, margin(k));

@@ -8,6 +8,7 @@
 
 mod interest;
 mod peaks;
+mod peaks_portable;
 mod peaks_simd;
 
 use crate::image::{Gray, Rect, VisionError};

@@ -5,7 +5,8 @@
 //! the rows above and below agree at its column, so no whole-frame map is written or read.
 //!
 //! Interest rows sit in the ring with `r` zeros either side, so the row maxima need no edge
-//! cases. The row pass has AVX-512 and AVX2 forms (`peaks_simd.rs`) and a portable twin.
+//! cases. The row pass has AVX-512 and AVX2 forms (`peaks_simd.rs`) and a portable twin
+//! (`peaks_portable.rs`).
 
 use super::Corner;
 use super::interest::RowSink;
@@ -21,6 +22,8 @@ pub(super) struct Peaks {
     tops: Vec<Vec<u32>>,
     /// Scratch: where the maxima of the rows round the one being finished start.
     offsets: Vec<usize>,
+    /// Scratch of the portable row pass (`peaks_portable.rs`).
+    spans: [Vec<u32>; 2],
     width: usize,
     height: usize,
     r: usize,
@@ -69,7 +72,8 @@ impl Peaks {
         let across = &mut self.across[s * ww..(s + 1) * ww];
         let tops = &mut self.tops[s];
         tops.clear();
-        super::peaks_simd::scan(self.path.unwrap_or_else(Path::active), row, r, t, across, tops);
+        let path = self.path.unwrap_or_else(Path::active);
+        super::peaks_simd::scan(path, row, r, t, across, tops, &mut self.spans);
     }
 
     /// Appends the corners of row `y` (all of rows `y - r ..= y + r` that exist are in the ring).
@@ -104,81 +108,6 @@ impl Peaks {
     pub(super) fn finish(&mut self, corners: &mut Vec<Corner>) {
         for y in self.height.saturating_sub(self.r)..self.height {
             self.finish_row(y, corners);
-        }
-    }
-}
-
-/// The portable twin of `peaks_simd::scan`: `across[x]` = the maxima of padded row `row` over
-/// `x ..= x + 2r`, and every `x` at or above `threshold` that equals it appended to `tops`.
-/// The common radii get their taps unrolled.
-pub(super) fn scan_portable(row: &[u32], r: usize, threshold: u32, across: &mut [u32], tops: &mut Vec<u32>) {
-    match r {
-        1 => scan_lanes::<3>(row, r, threshold, across, tops),
-        2 => scan_lanes::<5>(row, r, threshold, across, tops),
-        3 => scan_lanes::<7>(row, r, threshold, across, tops),
-        4 => scan_lanes::<9>(row, r, threshold, across, tops),
-        _ => scan_lanes::<0>(row, r, threshold, across, tops),
-    }
-}
-
-/// Pixels per block of [`scan_lanes`]: two SSE2 registers of 32-bit lanes.
-const LANES: usize = 8;
-
-/// [`scan_portable`] with `TAPS = 2r + 1` known (0: any `r`), a block of [`LANES`] pixels at a
-/// time, its maxima kept in registers across the taps and its tops found as a bit mask. An
-/// interest is at most 81 * 255² (23 bits), so its maxima and its comparison with the threshold
-/// are taken as `i32`: SSE2 compares signed 32-bit lanes (`pcmpgtd`) but not unsigned ones.
-#[inline(always)]
-fn scan_lanes<const TAPS: usize>(
-    row: &[u32],
-    r: usize,
-    threshold: u32,
-    across: &mut [u32],
-    tops: &mut Vec<u32>,
-) {
-    let ww = across.len();
-    let taps = if TAPS == 0 { 2 * r + 1 } else { TAPS };
-    let t = threshold.min(i32::MAX as u32) as i32;
-    let whole = ww - ww % LANES;
-    for (x, out) in (0..whole).step_by(LANES).zip(across.chunks_exact_mut(LANES)) {
-        let win = &row[x..x + LANES + taps - 1];
-        let lane = |tap: usize| -> [i32; LANES] { std::array::from_fn(|i| win[tap + i] as i32) };
-        // Two chains, so the maxima do not wait on each other.
-        let (mut even, mut odd) = (lane(0), [0i32; LANES]);
-        let mut tap = 1;
-        while tap + 1 < taps {
-            let (a, b) = (lane(tap), lane(tap + 1));
-            for i in 0..LANES {
-                odd[i] = odd[i].max(a[i]);
-                even[i] = even[i].max(b[i]);
-            }
-            tap += 2;
-        }
-        if tap < taps {
-            let a = lane(tap);
-            for i in 0..LANES {
-                odd[i] = odd[i].max(a[i]);
-            }
-        }
-        let v = lane(r);
-        let mut hits = 0u32;
-        for i in 0..LANES {
-            let m = even[i].max(odd[i]);
-            out[i] = m as u32;
-            hits |= u32::from(v[i] >= t && v[i] == m) << i;
-        }
-        while hits != 0 {
-            tops.push((x + hits.trailing_zeros() as usize) as u32);
-            hits &= hits - 1;
-        }
-    }
-    // The tail: the same rule, pixel by pixel.
-    for x in whole..ww {
-        let m = row[x..=x + 2 * r].iter().copied().max().unwrap_or(0);
-        across[x] = m;
-        let v = row[x + r];
-        if v >= threshold && v == m {
-            tops.push(x as u32);
         }
     }
 }

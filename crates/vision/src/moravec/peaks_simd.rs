@@ -1,16 +1,17 @@
 //! The SIMD forms of the Moravec peak search's row pass (the portable form is `scan_portable`
-//! in `peaks.rs`): the row-window maxima, and the pixels at or above the threshold that top
+//! in `peaks_portable.rs`): the row-window maxima, and the pixels at or above the threshold that top
 //! their row window, found sixteen (AVX-512) or eight (AVX2) at a time as a bit mask.
 
 #[cfg(target_arch = "x86_64")]
 use core::arch::x86_64::*;
 
-use super::peaks::scan_portable;
+use super::peaks_portable::scan_portable;
 use crate::simd::Path;
 
 /// Writes `across[x]`, the maxima of padded row `row` over `x ..= x + 2r` (the window round
 /// pixel `x`), for the `across.len()` pixels, and appends to `tops` every `x` whose own value
-/// is at or above `threshold` and equals that maximum, on `path` (lowered to one the CPU has).
+/// is at or above `threshold` and equals that maximum, on `path` (lowered to one the CPU has);
+/// `spans` is the portable form's scratch.
 pub(super) fn scan(
     path: Path,
     row: &[u32],
@@ -18,6 +19,7 @@ pub(super) fn scan(
     threshold: u32,
     across: &mut [u32],
     tops: &mut Vec<u32>,
+    spans: &mut [Vec<u32>; 2],
 ) {
     assert!(row.len() >= across.len() + 2 * r, "a padded row holds r zeros either side");
     match Path::clamp(path) {
@@ -27,7 +29,7 @@ pub(super) fn scan(
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
         Path::Avx2 => unsafe { scan_avx2(row, r, threshold, across, tops) },
-        _ => scan_portable(row, r, threshold, across, tops),
+        _ => scan_portable(row, r, threshold, across, tops, spans),
     }
 }
 
