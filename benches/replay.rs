@@ -32,15 +32,6 @@ fn timed(path: SimdPath, args: &[&str]) -> (f64, String) {
     (wall, text)
 }
 
-/// The CPU's model name (from `/proc/cpuinfo`, where there is one).
-fn cpu_model() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|t| t.lines().find(|l| l.starts_with("model name")).map(|l| l.to_owned()))
-        .and_then(|l| l.split_once(':').map(|(_, m)| m.trim().to_owned()))
-        .unwrap_or_else(|| "unknown".to_owned())
-}
-
 /// The speed the replayer reports: "replay finished: 57.8x real time".
 fn replay_factor(text: &str) -> f64 {
     text.split("replay finished: ")
@@ -104,7 +95,7 @@ fn main() {
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
-    println!("CPU: {}; SIMD features: {}", cpu_model(), simd::cpu_features());
+    println!("CPU: {}; SIMD features: {}", simd::cpu_model(), simd::cpu_features());
     println!(
         "replay of the reference recording (default mission, {sim_s} s simulated), {REPS} runs per \
          vision-kernel path (HARVEY_SIMD), interleaved, medians in x real time:"

@@ -91,15 +91,6 @@ fn path_of(kernel: &str) -> String {
     }
 }
 
-/// The CPU's model name (from `/proc/cpuinfo`, where there is one).
-fn cpu_model() -> String {
-    std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|t| t.lines().find(|l| l.starts_with("model name")).map(|l| l.to_owned()))
-        .and_then(|l| l.split_once(':').map(|(_, m)| m.trim().to_owned()))
-        .unwrap_or_else(|| "unknown".to_owned())
-}
-
 /// Times Harvey's kernel and the reference, in the same run.
 fn measure(mut row: Row, harvey: impl FnMut(), reference: impl FnMut()) -> Row {
     (row.harvey_us, row.reference_us) = (time(harvey), time(reference));
@@ -322,7 +313,7 @@ fn main() {
     let world = harvey_world::World::load(&root.join("worlds/hallway.toml")).expect("world");
     let out = root.join("target/vision-bench");
     std::fs::create_dir_all(&out).expect("output folder");
-    let (model, features, path) = (cpu_model(), simd::cpu_features(), SimdPath::active());
+    let (model, features, path) = (simd::cpu_model(), simd::cpu_features(), SimdPath::active());
     println!("CPU: {model}");
     println!("SIMD features: {features}");
     println!(

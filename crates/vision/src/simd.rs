@@ -103,6 +103,15 @@ impl fmt::Display for Path {
     }
 }
 
+/// The CPU's model name (from `/proc/cpuinfo`, where there is one; for benchmarks).
+pub fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| t.lines().find(|l| l.starts_with("model name")).map(|l| l.to_owned()))
+        .and_then(|l| l.split_once(':').map(|(_, m)| m.trim().to_owned()))
+        .unwrap_or_else(|| "unknown".to_owned())
+}
+
 /// The SIMD features of this CPU that the paths care about, space-separated (for benchmarks).
 pub fn cpu_features() -> String {
     let mut out: Vec<&str> = Vec::new();
