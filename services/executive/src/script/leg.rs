@@ -128,6 +128,12 @@ impl Leg {
         self.line.arc(d, 0.0)
     }
 
+    /// Whether the look asked for is the first, measuring the mount: discovery over the whole
+    /// frame (002 §5.2), where later looks track the landmark in the window the gates allow.
+    pub fn discovering(&self) -> bool {
+        self.phase == Phase::Calibrating
+    }
+
     /// Increments commanded so far.
     pub fn increments_done(&self) -> usize {
         self.done
@@ -340,7 +346,9 @@ mod tests {
         };
         let mut leg = Leg::new(Pose2::default(), 1.2, 0.6, Some(s));
         assert_eq!(leg.start(), LegStep::Look(Pose2::default()), "looks before moving");
+        assert!(leg.discovering(), "the first look, the mount unknown, searches the whole frame");
         assert_eq!(leg.on_seen(Some(seen(16.0))), LegStep::Move(0.6));
+        assert!(!leg.discovering());
         assert!((leg.mount_rad.0 - yaw).abs() < 1e-12 && (leg.mount_rad.1 - pitch).abs() < 1e-12);
         let LegStep::Look(_) = leg.on_done() else { panic!("looks") };
         // On the line after the increment, seen through the same mount: nothing to correct, and

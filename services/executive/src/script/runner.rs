@@ -75,9 +75,13 @@ impl Script {
                     return Vec::new();
                 };
                 let Some(s) = l.servo else { return Vec::new() };
-                // Searched only where a sighting the leg would accept can be.
-                let window =
-                    super::window::look_window(&s, expected, l.mount_rad, l.offset_m, sv.template_px);
+                // Tracked only where a sighting the leg would accept can be; the first look, with
+                // the mount not yet measured, discovers the landmark in the whole frame.
+                let window = (!l.discovering())
+                    .then(|| {
+                        super::window::look_window(&s, expected, l.mount_rad, l.offset_m, sv.template_px)
+                    })
+                    .flatten();
                 let request = self.next_request;
                 self.next_request += 1;
                 self.phase = Phase::Looking { step, request };

@@ -144,6 +144,12 @@ fn a_servoed_leg_looks_after_each_increment_and_turns_the_correction() {
     assert_eq!((look.request_id, look.landmark_index), (100, 7));
     assert!((look.expected.x_m - 0.6).abs() < 1e-12 && look.expected.y_m == 0.0, "{look:?}");
     assert_eq!(status(&out).servo, ServoLevel::Action as u32);
+    // Tracked in the window the gates allow (3 degrees, 29 px either way), not the whole frame:
+    // 10 px off is inside, 40 px off is not.
+    let [u0, _, u1, _] = look.window_px;
+    let predicted = (320.0 - 554.0 * (0.2f64 / 15.4)) as f32;
+    assert!(u0 < predicted - 10.0 && predicted + 10.0 < u1, "{:?}", look.window_px);
+    assert!(u0 > predicted - 45.0 && predicted + 45.0 > u1, "{:?}", look.window_px);
     // Another request's answer is not this look's.
     assert!(e.on_vision(&seen(99, 3.1, Some([300.0, 240.0]))).is_empty());
     // Seen 10 px right of where the line puts it: turned left, so a turn back right.
