@@ -102,15 +102,21 @@ fn servoing_holds_the_line_for_40_ft_where_open_loop_wanders_off_it() {
 
 #[test]
 fn over_seeds_servoing_holds_the_line_within_its_budget() {
-    for condition in ["ideal", "nominal"] {
+    for condition in ["ideal", "nominal", "harsh"] {
         for seed in 1..=3 {
             let out = common::run_mission_under("missions/hallway-40ft.toml", condition, seed, "h40s");
             let Run { truth, looks, .. } = decode(out, "missions/hallway-40ft.toml", "1/1");
             let held = worst(&truth, 0.0, 40.0) / INCH;
             println!("{condition} s{seed}: at most {held:.3} in off the line");
             // The paper's 0.3 in where the map is the world; its 0.3 in plus the map's 0.28 in
-            // (above) under the shipped sensors.
-            let bound = if condition == "ideal" { 0.3 } else { 0.58 };
+            // (above) under the shipped sensors; under harsh, whose map is twice as far off (2 cm
+            // sd), twice that. Harsh seed 2 left the line by 16 in while the looks searched the
+            // whole frame (another surface's match, refused, every look after it).
+            let bound = match condition {
+                "ideal" => 0.3,
+                "nominal" => 0.58,
+                _ => 0.3 + 2.0 * 0.28,
+            };
             assert!(held <= bound, "{condition} s{seed}: {held:.3} in off the line");
             assert_eq!(looks.len(), 21, "{condition} s{seed}");
         }
