@@ -53,10 +53,15 @@ const decoded = {};
 const errors = [];
 let timeMessages = 0;
 
+let finished = false;
 function finish(code) {
+  if (finished) return;
+  finished = true;
   out({ summary: { received, decoded, errors, time_messages: timeMessages, subprotocol: ws.protocol } });
   ws.close();
-  process.exit(code);
+  // Exit once stdout has drained: a write to a full pipe is queued, and process.exit() would drop
+  // it (an echoed camera frame's line is some 600 kB; the reader saw it cut at 64 KiB).
+  process.stdout.write("", () => process.exit(code));
 }
 
 const needsMet = () =>
@@ -86,6 +91,7 @@ client.on("advertise", (advertised) => {
 });
 
 client.on("message", ({ subscriptionId, timestamp, data }) => {
+  if (finished) return;
   const ch = channels.get(subscriptionId);
   if (!ch) return;
   received[ch.topic] = (received[ch.topic] ?? 0) + 1;
