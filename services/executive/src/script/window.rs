@@ -24,9 +24,7 @@ pub fn look_window(
     template_px: u32,
 ) -> Option<[f32; 4]> {
     let f = s.params.focal_px;
-    let (c, sn) = (expected.heading_rad.cos(), expected.heading_rad.sin());
-    let (dx, dy) = (s.point[0] - expected.x_m, s.point[1] - expected.y_m);
-    let (ahead, left) = (dx * c + dy * sn, -dx * sn + dy * c);
+    let [ahead, left] = expected.inverse().apply([s.point[0], s.point[1]]);
     if ahead < 0.5 {
         return None;
     }
