@@ -1,7 +1,7 @@
 //! The line finder's gradient pass: the bucket byte of every 2x2 cell of a window. One body
 //! compiled for each [`Path`] (the same bytes on all): per row, the gradients of every cell and
 //! a strong-or-not mark (a vectorised pass), then the orientation look-up for the strong cells
-//! only, stretches of [`CHUNK`] weak cells passed over with one vectorised test.
+//! only, weak cells passed over eight at a time (one 64-bit test).
 
 use crate::image::{Gray, Rect};
 use crate::simd::Path;
@@ -10,9 +10,6 @@ use crate::simd::Path;
 pub(crate) const G: i32 = 255;
 /// The side of the look-up table, indexed by `(gy + G) * SIDE + gx + G`.
 pub(crate) const SIDE: usize = (2 * G + 1) as usize;
-
-/// Cells tested at once where none is strong.
-const CHUNK: usize = 32;
 
 /// One window's pass: `labels` gets `(width - 1) x (height - 1)` bucket bytes (0: weak), a
 /// cell strong where `gx² + gy² >= strong`; `g` is scratch of `2 (width - 1)`.
@@ -59,8 +56,8 @@ fn label_rows(p: Pass<'_, '_>) {
         }
         let mut x = 0;
         while x < ww {
-            if x + CHUNK <= ww && out[x..x + CHUNK].iter().fold(0u8, |a, &b| a | b) == 0 {
-                x += CHUNK;
+            if x + 8 <= ww && zero8(&out[x..x + 8]) {
+                x += 8;
                 continue;
             }
             if out[x] != 0 {
@@ -70,6 +67,14 @@ fn label_rows(p: Pass<'_, '_>) {
             x += 1;
         }
     }
+}
+
+/// Whether eight bytes are all zero, read as one word.
+#[inline(always)]
+fn zero8(b: &[u8]) -> bool {
+    let mut w = [0u8; 8];
+    w.copy_from_slice(&b[..8]);
+    u64::from_ne_bytes(w) == 0
 }
 
 /// [`label_rows`] compiled for AVX-512.

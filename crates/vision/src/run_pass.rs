@@ -1,9 +1,9 @@
 //! Run extraction, the part of [`Runs::build`](crate::regions::Runs::build) that reads every
 //! label: each row's maximal runs of one non-zero class, left to right, rows top to bottom. One
 //! body compiled for each [`Path`] (the same runs on all): per row the classes are taken from
-//! their nibble into a scratch row (a vectorised pass), and a stretch of [`CHUNK`] classes that
+//! their nibble into a scratch row (a vectorised pass), and each chunk of [`CHUNK`] classes that
 //! all continue the current run (background or a class) is passed over with one vectorised
-//! compare; only the columns where a run may start or end are looked at one by one.
+//! compare; only the other chunks are looked at column by column.
 
 use crate::regions::Run;
 use crate::simd::Path;
@@ -59,18 +59,27 @@ fn extract_rows(labels: Labels<'_>, cls: &mut [u8], runs: &mut Vec<Run>, rows: &
         }
         let (mut x, mut x0, mut cur) = (0, 0, 0u8);
         while x < w {
-            if x + CHUNK <= w && continues(&cls[x..x + CHUNK], cur) {
-                x += CHUNK;
+            // A chunk is tested once: if it does not all continue the run, it is walked through.
+            let end = (x + CHUNK).min(w);
+            if end - x == CHUNK && continues(&cls[x..end], cur) {
+                x = end;
                 continue;
             }
-            let c = cls[x];
-            if c != cur {
-                if cur != 0 {
-                    runs.push(Run { y: y as u32, x0: x0 as u32, x1: x as u32, class: cur, region: 0 });
+            for (i, &c) in cls[x..end].iter().enumerate() {
+                if c != cur {
+                    if cur != 0 {
+                        runs.push(Run {
+                            y: y as u32,
+                            x0: x0 as u32,
+                            x1: (x + i) as u32,
+                            class: cur,
+                            region: 0,
+                        });
+                    }
+                    (x0, cur) = (x + i, c);
                 }
-                (x0, cur) = (x, c);
             }
-            x += 1;
+            x = end;
         }
         if cur != 0 {
             runs.push(Run { y: y as u32, x0: x0 as u32, x1: w as u32, class: cur, region: 0 });
