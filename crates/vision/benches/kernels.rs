@@ -79,11 +79,21 @@ impl Row {
     }
 }
 
-/// The path a kernel runs: the dispatched one for correlation, Moravec and what is built on
-/// them; the rest have no hand-written SIMD and run the build's baseline code.
+/// The path a kernel runs: the dispatched one for correlation, Moravec, activity, the line
+/// finder, the segmenter and what is built on them; the rest run the build's baseline code.
 fn path_of(kernel: &str) -> String {
-    let dispatched =
-        ["normalised correlation", "Moravec", "coarse-to-fine", "stereo", "depth from motion", "activity"];
+    let dispatched = [
+        "normalised correlation",
+        "Moravec",
+        "coarse-to-fine",
+        "stereo",
+        "depth from motion",
+        "activity",
+        "fast line finder",
+        "fast region segmenter",
+        "path following",
+        "phototropic",
+    ];
     if dispatched.iter().any(|k| kernel.starts_with(k)) {
         SimdPath::active().name().to_owned()
     } else {
@@ -324,10 +334,17 @@ fn main() {
     );
     if std::env::args().any(|a| a == "paths") {
         let img = frame(&world, 640, 480);
-        if !std::env::args().any(|a| a == "moravec") {
+        let only = |k: &str| std::env::args().any(|a| a == k);
+        let all = !only("moravec") && !only("flf");
+        if all {
             paths::compare(&img.view(), "640x480");
         }
-        paths::compare_moravec(&img.view(), "640x480");
+        if all || only("moravec") {
+            paths::compare_moravec(&img.view(), "640x480");
+        }
+        if all || only("flf") {
+            paths::compare_flf_frs(&img.view(), "640x480");
+        }
         return;
     }
     let mut rows = Vec::new();

@@ -1,17 +1,21 @@
-//! The instruction-set paths of normalised correlation and Moravec against each other, in one
-//! run: `cargo bench -p harvey-vision --bench kernels -- paths` (`-- paths moravec`: Moravec
-//! only). Each path the CPU has (set per correlator or operator, so no `HARVEY_SIMD` is needed)
+//! The instruction-set paths of normalised correlation, Moravec, the line finder and the region
+//! segmenter against each other, in one run: `cargo bench -p harvey-vision --bench kernels --
+//! paths` (`-- paths moravec`: Moravec only; `-- paths flf`: the line finder and segmenter). Each path the CPU has (set per correlator or operator, so no `HARVEY_SIMD` is needed)
 //! is timed in turn, several rounds interleaved so that a noisy machine slows them alike; a
 //! round's figure is the median of its calls, the table's the median of the rounds, and each
 //! ratio the median of the rounds' ratios to the portable path. Rows: the pruned search
 //! (`Correlator::best`, the kernels bench's row), every placement's score
-//! (`Correlator::correlate`, the cross-sum of all of them) and Moravec 5x5's corners.
+//! (`Correlator::correlate`, the cross-sum of all of them), Moravec 5x5's corners, and the line
+//! finder's and segmenter's rows of the kernels bench (same settings).
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 use std::hint::black_box;
 
+use harvey_vision::flf::{Flf, FlfParams};
+use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
+use harvey_vision::regions::Runs;
 use harvey_vision::simd::Path as SimdPath;
 use harvey_vision::{Gray, GrayBuf, Rect};
 
@@ -54,6 +58,50 @@ pub fn compare_moravec(img: &Gray<'_>, size: &str) {
         time(|| {
             black_box(m.corners(img, win, &p).expect("runs").len());
         })
+    });
+}
+
+/// Times the line finder and the segmenter (the kernels bench's rows and settings) on each
+/// available path, full frame and a 96x96 window, and the segmenter's run extraction and joining
+/// alone on the full frame's class image.
+pub fn compare_flf_frs(img: &Gray<'_>, size: &str) {
+    let win = around(img, textured(img, 16), 96);
+    let rows = [
+        ("fast line finder", "full frame", img.full()),
+        ("fast line finder", "96x96 window", win),
+        ("fast region segmenter + stats", "full frame", img.full()),
+        ("fast region segmenter + stats", "96x96 window", win),
+        ("segmenter's runs alone (Runs::build)", "full frame", img.full()),
+    ];
+    let ranges = [
+        ClassRange { lo: 0, hi: 70, class: 1 },
+        ClassRange { lo: 71, hi: 170, class: 2 },
+        ClassRange { lo: 171, hi: 255, class: 3 },
+    ];
+    let p = FlfParams::default();
+    // The segmenter's class image of the frame, for the runs alone.
+    let class = |v: u8| ranges.iter().find(|r| (r.lo..=r.hi).contains(&v)).map_or(0, |r| r.class);
+    let labels: Vec<u8> = (0..img.height).flat_map(|y| img.row(y).iter().map(|&v| class(v))).collect();
+    table(size, &rows, |path, &(kernel, _, win)| {
+        if kernel.starts_with("segmenter's runs") {
+            let mut runs = Runs::default();
+            time(|| {
+                runs.build(&labels, img.width, img.height, false, path);
+                black_box(runs.regions);
+            })
+        } else if kernel == "fast line finder" {
+            let mut f = Flf::default();
+            f.set_path(path);
+            time(|| {
+                black_box(f.lines(img, win, &p).expect("runs").len());
+            })
+        } else {
+            let mut f = Frs::default();
+            f.set_path(path);
+            time(|| {
+                black_box(f.segment(img, win, &ranges, 20).expect("segments").len());
+            })
+        }
     });
 }
 

@@ -11,8 +11,10 @@
 //! Regions are built from runs of equal bucket along rows joined by union-find, and their
 //! moments come from closed forms over each run, so the work is per run, not per pixel.
 
+use crate::flf_pass::{self, G, Pass, SIDE};
 use crate::image::{Gray, Rect, VisionError};
 use crate::regions::{Moments, Runs, cell_gradient};
+use crate::simd::Path;
 
 /// Settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -71,13 +73,21 @@ pub struct Flf {
     lengths: [Vec<f32>; 2],
     votes: Vec<u32>,
     lines: Vec<Line>,
+    path: Option<Path>,
 }
 
-/// Gradient components are halved sums of a 2x2 cell, in -255..=255.
-const G: i32 = 255;
-const SIDE: usize = (2 * G + 1) as usize;
-
 impl Flf {
+    /// Runs on `path` from now on (lowered to the fastest the CPU has): every path finds the
+    /// same lines, bit for bit.
+    pub fn set_path(&mut self, path: Path) {
+        self.path = Some(Path::clamp(path));
+    }
+
+    /// The path the gradient pass and the run extraction take.
+    pub fn path(&self) -> Path {
+        self.path.unwrap_or_else(Path::active)
+    }
+
     /// The lines in `window`, longest first.
     pub fn lines(&mut self, img: &Gray<'_>, window: Rect, p: &FlfParams) -> Result<&[Line], VisionError> {
         let w = window.inside(img.width, img.height)?;
@@ -108,9 +118,9 @@ impl Flf {
         self.label(img, w, p);
         let (ww, wh) = (w.width() - 1, w.height() - 1);
         let partitions = if p.overlap { 2 } else { 1 };
+        let path = self.path();
         for k in 0..partitions {
-            let shift = 4 * k as u32;
-            self.runs[k].build(&self.labels, ww, wh, |b| (b >> shift) & 0x0f);
+            self.runs[k].build(&self.labels, ww, wh, k == 1, path);
             // Cell (x, y) lies between pixels x, x + 1 and rows y, y + 1: centred on the pixel
             // corner (w.x0 + x + 1, w.y0 + y + 1).
             let origin = [w.x0 as f64 + 1.0, w.y0 as f64 + 1.0];
@@ -192,53 +202,10 @@ impl Flf {
         self.gradients.clear();
         self.gradients.resize(2 * ww, 0);
         let strong = (p.min_gradient * p.min_gradient).max(1.0).ceil() as i32;
-        let (lut, labels, g) = (&self.lut, &mut self.labels, &mut self.gradients);
-        #[cfg(target_arch = "x86_64")]
-        if std::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has AVX2.
-            unsafe { label_avx2(img, w, strong, lut, labels, g) };
-            return;
-        }
-        label_rows(img, w, strong, lut, labels, g);
-    }
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn label_avx2(img: &Gray<'_>, w: Rect, strong: i32, lut: &[u8], labels: &mut [u8], g: &mut [i16]) {
-    label_rows(img, w, strong, lut, labels, g)
-}
-
-/// Per row: the gradients and a strong-or-not mark for every cell (vectorised), then the
-/// look-up for the strong cells only, skipping weak ones eight at a time.
-#[inline(always)]
-fn label_rows(img: &Gray<'_>, w: Rect, strong: i32, lut: &[u8], labels: &mut [u8], g: &mut [i16]) {
-    let (ww, wh) = (w.width() - 1, w.height() - 1);
-    let (gxs, gys) = g.split_at_mut(ww);
-    for y in 0..wh {
-        let (r0, r1) = (&img.row(w.y0 + y)[w.x0..w.x1], &img.row(w.y0 + y + 1)[w.x0..w.x1]);
-        let out = &mut labels[y * ww..(y + 1) * ww];
-        for x in 0..ww {
-            let (a, b, c, d) =
-                (i32::from(r0[x]), i32::from(r0[x + 1]), i32::from(r1[x]), i32::from(r1[x + 1]));
-            let gx = (b + d - a - c) / 2;
-            let gy = (c + d - a - b) / 2;
-            gxs[x] = gx as i16;
-            gys[x] = gy as i16;
-            out[x] = u8::from(gx * gx + gy * gy >= strong);
-        }
-        let mut x = 0;
-        while x < ww {
-            if x + 8 <= ww && crate::regions::zero8(&out[x..x + 8]) {
-                x += 8;
-                continue;
-            }
-            if out[x] != 0 {
-                let (gx, gy) = (i32::from(gxs[x]), i32::from(gys[x]));
-                out[x] = lut[((gy + G) as usize) * SIDE + (gx + G) as usize];
-            }
-            x += 1;
-        }
+        let path = self.path();
+        let pass =
+            Pass { img, window: w, strong, lut: &self.lut, labels: &mut self.labels, g: &mut self.gradients };
+        flf_pass::label(path, pass);
     }
 }
 

@@ -7,6 +7,7 @@
 
 use crate::image::{Gray, Rect, VisionError};
 use crate::regions::{Moments, Runs};
+use crate::simd::Path;
 
 /// One class: pixel values `lo ..= hi` are labelled `class` (1 to 15).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -37,9 +38,16 @@ pub struct Frs {
     runs: Runs,
     moments: Vec<Moments>,
     regions: Vec<Region>,
+    path: Option<Path>,
 }
 
 impl Frs {
+    /// Runs on `path` from now on (lowered to the fastest the CPU has): every path finds the
+    /// same regions, bit for bit.
+    pub fn set_path(&mut self, path: Path) {
+        self.path = Some(Path::clamp(path));
+    }
+
     /// The regions of at least `min_area` pixels in `window`, largest first. Where ranges
     /// overlap, the first listed wins.
     pub fn segment(
@@ -70,7 +78,7 @@ impl Frs {
                 *l = lut[v as usize];
             }
         }
-        self.runs.build(&self.labels, ww, wh, |c| c);
+        self.runs.build(&self.labels, ww, wh, false, self.path.unwrap_or_else(Path::active));
         let origin = [w.x0 as f64 + 0.5, w.y0 as f64 + 0.5];
         self.runs.moments(origin, &mut self.moments, |x, y| f32::from(img.at(w.x0 + x, w.y0 + y)));
         self.regions.clear();

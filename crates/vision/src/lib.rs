@@ -7,6 +7,7 @@ mod cross;
 pub mod cues;
 pub mod depth;
 pub mod flf;
+mod flf_pass;
 pub mod frs;
 pub mod hough;
 pub mod image;
@@ -18,6 +19,7 @@ pub mod noise;
 pub mod path;
 pub mod pyramid;
 pub mod regions;
+mod run_pass;
 pub mod simd;
 pub mod stereo;
 

@@ -3,6 +3,8 @@
 //! closed forms over each run. Shared by the line finder and the region segmenter.
 
 use crate::image::Gray;
+use crate::run_pass::{self, Labels};
+use crate::simd::Path;
 
 /// A fitted line with its region's statistics.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,6 +38,9 @@ pub struct Runs {
     pub regions: usize,
     parent: Vec<u32>,
     index: Vec<u32>,
+    /// Each row's first run, then the run count.
+    rows: Vec<u32>,
+    scratch: Vec<u8>,
 }
 
 fn find(parent: &mut [u32], mut i: u32) -> u32 {
@@ -48,37 +53,19 @@ fn find(parent: &mut [u32], mut i: u32) -> u32 {
 }
 
 impl Runs {
-    /// Runs of `class_of(label)` (0: background) over a `w x h` label image, and their regions.
-    pub fn build(&mut self, labels: &[u8], w: usize, h: usize, class_of: impl Fn(u8) -> u8) {
-        self.runs.clear();
+    /// Runs of each label's class (its `high` or low nibble; 0: background) over a `w x h` label
+    /// image, and their regions; the runs are extracted on `path` (the same on every path).
+    pub fn build(&mut self, labels: &[u8], w: usize, h: usize, high: bool, path: Path) {
+        let labels = Labels { data: labels, w, h, high };
+        run_pass::extract(path, labels, &mut self.scratch, &mut self.runs, &mut self.rows);
         self.parent.clear();
+        self.parent.extend(0..self.runs.len() as u32);
         let mut above = 0..0;
         for y in 0..h {
-            let row = &labels[y * w..(y + 1) * w];
-            let start = self.runs.len();
-            let mut x = 0;
-            while x < w {
-                // Background (label 0) is the rule: skip it eight bytes at a time.
-                if x + 8 <= w && zero8(&row[x..x + 8]) {
-                    x += 8;
-                    continue;
-                }
-                let c = class_of(row[x]);
-                if c == 0 {
-                    x += 1;
-                    continue;
-                }
-                let x0 = x;
-                while x < w && class_of(row[x]) == c {
-                    x += 1;
-                }
-                let id = self.runs.len() as u32;
-                self.runs.push(Run { y: y as u32, x0: x0 as u32, x1: x as u32, class: c, region: 0 });
-                self.parent.push(id);
-            }
+            let (start, end) = (self.rows[y] as usize, self.rows[y + 1] as usize);
             // Join with the touching runs above (diagonal contact counts).
             let mut j = above.start;
-            for i in start..self.runs.len() {
+            for i in start..end {
                 let r = self.runs[i];
                 while j < above.end && self.runs[j].x1 < r.x0 {
                     j += 1;
@@ -94,7 +81,7 @@ impl Runs {
                     k += 1;
                 }
             }
-            above = start..self.runs.len();
+            above = start..end;
         }
         self.index.clear();
         self.index.resize(self.runs.len(), u32::MAX);
@@ -256,12 +243,4 @@ pub fn cell_gradient(img: &Gray<'_>, x: usize, y: usize) -> f32 {
     let (c, d) = (f32::from(img.at(x, y + 1)), f32::from(img.at(x + 1, y + 1)));
     let (gx, gy) = ((b + d - a - c) / 2.0, (c + d - a - b) / 2.0);
     (gx * gx + gy * gy).sqrt()
-}
-
-/// Whether eight bytes are all zero, read as one word.
-#[inline(always)]
-pub(crate) fn zero8(b: &[u8]) -> bool {
-    let mut w = [0u8; 8];
-    w.copy_from_slice(&b[..8]);
-    u64::from_ne_bytes(w) == 0
 }

@@ -1,6 +1,7 @@
 //! Every instruction-set path this CPU has (`harvey_vision::simd::Path::available`) gives the
 //! same results, bit for bit, as the portable one: correlation scores and matches, Moravec
-//! interest maps and corners, and coarse-to-fine matches, on random images of odd widths (1, 15,
+//! interest maps and corners, coarse-to-fine matches, the fast line finder's lines (its gradient
+//! pass and run extraction) and the region segmenter's regions (its runs), on random images of odd widths (1, 15,
 //! 17, 641 px: no path may read past a row end or lose the last pixels) and on rendered frames;
 //! and the pruned search of `Correlator::best` gives the exhaustive search's match, bit for bit,
 //! with templates cut from the frame searched (best score 1) and from another frame (below 1).
@@ -8,6 +9,8 @@
 
 use harvey_msgs::Encoding;
 use harvey_render::Renderer;
+use harvey_vision::flf::{Flf, FlfParams};
+use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Match, Template};
 use harvey_vision::pyramid::{Pyramid, coarse_to_fine};
@@ -112,6 +115,55 @@ fn moravec_agrees(img: &Gray<'_>, win: Rect) {
     }
 }
 
+/// The line finder's lines in `win` on each path (overlapping partitions and one, adaptive and
+/// fixed floors), all equal to the portable ones; how many lines they find.
+fn flf_agrees(img: &Gray<'_>, win: Rect) -> usize {
+    let base = FlfParams { min_length: 2.0, max_dispersion: 10.0, ..FlfParams::default() };
+    let mut found = 0;
+    for p in [
+        base,
+        FlfParams { overlap: false, buckets: 5, offset_deg: 10.0, ..base },
+        FlfParams { noise_factor: 0.0, min_gradient: 2.0, ..base },
+    ] {
+        let mut want = Flf::default();
+        want.set_path(Path::Portable);
+        let lines = format!("{:?}", want.lines(img, win, &p).expect("runs"));
+        for path in Path::available() {
+            let mut f = Flf::default();
+            f.set_path(path);
+            assert_eq!(f.path(), path);
+            assert_eq!(format!("{:?}", f.lines(img, win, &p).expect("runs")), lines, "{path}: {win}, {p:?}");
+        }
+        found += want.lines(img, win, &p).expect("runs").len();
+    }
+    found
+}
+
+/// The segmenter's regions in `win` on each path (three classes and a gap, then one wide
+/// class), all equal to the portable ones; how many regions they find.
+fn frs_agrees(img: &Gray<'_>, win: Rect) -> usize {
+    let three = [
+        ClassRange { lo: 0, hi: 70, class: 1 },
+        ClassRange { lo: 71, hi: 150, class: 2 },
+        ClassRange { lo: 171, hi: 255, class: 15 },
+    ];
+    let one = [ClassRange { lo: 20, hi: 240, class: 7 }];
+    let mut found = 0;
+    for ranges in [&three[..], &one[..]] {
+        let mut want = Frs::default();
+        want.set_path(Path::Portable);
+        let regions = format!("{:?}", want.segment(img, win, ranges, 1).expect("segments"));
+        for path in Path::available() {
+            let mut f = Frs::default();
+            f.set_path(path);
+            let got = format!("{:?}", f.segment(img, win, ranges, 1).expect("segments"));
+            assert_eq!(got, regions, "{path}: {win}, {ranges:?}");
+        }
+        found += want.segment(img, win, ranges, 1).expect("segments").len();
+    }
+    found
+}
+
 #[test]
 fn random_images_of_odd_widths_agree_on_every_path() {
     // The large templates span several of the portable kernel's chunks of columns and groups of
@@ -132,8 +184,12 @@ fn random_images_of_odd_widths_agree_on_every_path() {
             }
         }
         moravec_agrees(&v, v.full());
+        assert!(flf_agrees(&v, v.full()) > 0 || w < 33, "{w}x{h}: no line");
+        assert!(frs_agrees(&v, v.full()) > 0, "{w}x{h}: no region");
         if w > 4 && h > 4 {
             moravec_agrees(&v, Rect::new(1, 2, w - 2, h - 1));
+            flf_agrees(&v, Rect::new(1, 2, w - 2, h - 1));
+            frs_agrees(&v, Rect::new(1, 2, w - 2, h - 1));
         }
     }
 }
@@ -150,6 +206,8 @@ fn rendered_frames_agree_on_every_path() {
             let at = Rect::new(cx, cy, cx + side, cy + side);
             correlation_agrees(&v, v.full(), at);
             moravec_agrees(&v, v.full());
+            let (lines, regions) = (flf_agrees(&v, v.full()), frs_agrees(&v, v.full()));
+            assert!(w < 600 || (lines > 10 && regions > 0), "{w}x{h}: {lines} lines, {regions} regions");
         }
         // Templates from the other pose's frame: best scores below 1, found among near misses.
         let (a, b) = (rendered(w, h, poses[0]), rendered(w, h, poses[1]));
