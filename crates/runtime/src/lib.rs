@@ -8,12 +8,14 @@
 
 pub mod checkpoint;
 pub mod journal;
+pub mod node;
 pub mod resume;
 pub mod rosout;
 pub mod throttle;
 
 pub use checkpoint::{Checkpoint, CheckpointError, STATE_DIR_ENV};
 pub use journal::Journal;
+pub use node::{In, Io, Node, Out, Ports};
 pub use resume::{Marks, Resume, Sent};
 pub use rosout::Rosout;
 pub use throttle::{Say, Throttle};

@@ -87,6 +87,11 @@ impl<S: Serialize + DeserializeOwned> Resume<S> {
         &mut self.state
     }
 
+    /// The state and what it has taken, apart (a runner hands the marks to a node's turn).
+    pub fn parts(&mut self) -> (&mut S, &mut Marks) {
+        (&mut self.state, &mut self.taken)
+    }
+
     /// Whether an input on `topic` is news to the state (and notes it taken).
     pub fn fresh(&mut self, topic: &str, stamp_ns: u64, seq: u64) -> bool {
         self.taken.fresh(topic, stamp_ns, seq)

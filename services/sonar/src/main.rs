@@ -3,9 +3,8 @@
 //! checkpointed every tick, so a restarted sonar service goes on where it was.
 
 use clap::Parser;
-use harvey_bus::{Bus, Pace, Publisher, Step, Waiter};
-use harvey_msgs::{Message, topics};
-use harvey_runtime::{Resume, Sent};
+use harvey_msgs::{MotionCommand, Odometry, SonarRaw, SonarRing, topics};
+use harvey_runtime::{In, Io, Node, Out};
 use harvey_sonar::SonarRingBuilder;
 use harvey_sonar::avoid::{AvoidParams, PanicAvoid};
 
@@ -35,90 +34,87 @@ struct Args {
     avoid_dash_ft: f64,
 }
 
-/// Sends `m` unless a predecessor of this process sent it before it was killed; `key` names
-/// the numbering (the panic-stop and the panic-avoid number their commands apart).
-fn send<T: Message>(sent: &mut Sent, key: &str, port: &Publisher<T>, m: &T) -> anyhow::Result<()> {
-    let h = *m.header();
-    if sent.due(key, h.stamp_ns, h.seq) {
-        port.send(m)?;
-        sent.done(key, h.stamp_ns, h.seq)?;
-    }
-    Ok(())
+/// The sonar service as a node: odometry first (the panic-avoid's dash), then the banks.
+struct Sonar {
+    raw: In<SonarRaw>,
+    odometry: In<Odometry>,
+    ring_out: Out<SonarRing>,
+    commands: Out<MotionCommand>,
+    /// The panic-stop's distance and the panic-avoid's settings (none: no panic-avoid).
+    stop_m: f64,
+    avoid: Option<AvoidParams>,
+    banks: Vec<SonarRaw>,
+    poses: Vec<Odometry>,
+    rings: u64,
 }
 
-/// Room for the ring, the reflexes' state and the marks.
-const SLOT_BYTES: usize = 64 << 10;
+impl Node for Sonar {
+    type State = (SonarRingBuilder, Option<PanicAvoid>);
+    /// Room for the ring, the reflexes' state and the marks.
+    const CHECKPOINT_BYTES: usize = 64 << 10;
 
-fn main() -> anyhow::Result<()> {
-    harvey_runtime::init_logging();
-    let args = Args::parse();
-    let bus = Bus::join("sonar")?;
-    let raw = bus.subscriber(topics::DRV_SONAR_RAW)?;
-    let odometry = bus.subscriber(topics::ODOMETRY)?;
-    let ring_pub = bus.publisher(topics::SONAR_RING)?;
-    let command_pub = bus.publisher(topics::VEHICLE_REFLEX)?;
-    let mut rosout = harvey_runtime::Rosout::new(&bus, "sonar")?;
-    let pace = Pace::from_env(&bus)?;
-    let waiter = Waiter::new()?;
-    let _a = pace.attach(&waiter, &[&raw, &odometry])?;
-    harvey_runtime::notify_ready()?;
-
-    use harvey_geometry::FT;
-    let ring = SonarRingBuilder::new(args.panic_stop_ft * FT);
-    let avoid = (args.avoid_dash_ft > 0.0).then(|| {
-        PanicAvoid::new(AvoidParams {
-            ttc_s: args.avoid_ttc_s,
-            confirm: args.avoid_confirm,
-            min_approach_mps: args.avoid_min_approach_ftps * FT,
-            arc_rad: std::f64::consts::FRAC_PI_6,
-            turn_rad: args.avoid_turn_deg.to_radians(),
-            dash_m: args.avoid_dash_ft * FT,
-            stop_m: args.panic_stop_ft * FT,
-        })
-    });
-    let mut resume = Resume::from_env("sonar", SLOT_BYTES, || (ring, avoid))?;
-    let mut sent = Sent::from_env("sonar")?;
-    if resume.resumed() {
-        tracing::warn!("resumed from the checkpoint");
+    fn start(&mut self) -> Self::State {
+        (SonarRingBuilder::new(self.stop_m), self.avoid.map(PanicAvoid::new))
     }
-    let (mut banks, mut poses) = (Vec::new(), Vec::new());
-    let (mut rings, mut newest) = (0u64, 0);
-    while let Step::Go(tick) = pace.next(&waiter, None)? {
-        rosout.begin();
-        odometry.drain_into(&mut poses)?;
-        poses.retain(|m| resume.fresh(odometry.topic(), m.header().stamp_ns, m.header().seq));
-        raw.drain_into(&mut banks)?;
-        banks.retain(|m| resume.fresh(raw.topic(), m.header().stamp_ns, m.header().seq));
-        newest = banks.iter().map(|b| b.header.stamp_ns).fold(newest, u64::max);
-        for o in &poses {
-            if let Some(c) = resume.state().1.as_mut().and_then(|a| a.on_odometry(o)) {
+
+    fn step(&mut self, (ring, avoid): &mut Self::State, io: &mut Io<'_>) -> anyhow::Result<()> {
+        io.take(self.odometry, &mut self.poses)?;
+        io.take(self.raw, &mut self.banks)?;
+        for o in &self.poses {
+            if let Some(c) = avoid.as_mut().and_then(|a| a.on_odometry(o)) {
                 tracing::warn!(command = c.command_id, kind = c.kind, "panic-avoid");
-                send(&mut sent, "panic-avoid", &command_pub, &c)?;
+                io.send_as(self.commands, "panic-avoid", &c)?;
             }
         }
-        for bank in &banks {
-            let (ring, avoid) = resume.state();
+        for bank in &self.banks {
             match ring.on_bank(bank) {
                 Ok(update) => {
                     let evade = avoid.as_mut().and_then(|a| a.on_ring(&update.ring));
                     if let Some(stop) = update.panic_stop {
-                        send(&mut sent, "panic-stop", &command_pub, &stop)?;
+                        io.send_as(self.commands, "panic-stop", &stop)?;
                     }
                     if let Some(c) = evade {
                         tracing::warn!("panic-avoid: an object is bearing down; stopping to evade");
-                        send(&mut sent, "panic-avoid", &command_pub, &c)?;
+                        io.send_as(self.commands, "panic-avoid", &c)?;
                     }
-                    send(&mut sent, ring_pub.topic(), &ring_pub, &update.ring)?;
-                    rings += 1;
+                    io.send(self.ring_out, &update.ring)?;
+                    self.rings += 1;
                 }
                 Err(e) => tracing::warn!("dropping a sonar report: {e}"),
             }
         }
-        rosout.end(tick.unwrap_or(newest))?;
-        resume.tick_done()?;
-        pace.done()?;
+        Ok(())
     }
-    let episodes = resume.state().1.as_ref().map_or(0, |a| a.episodes);
-    tracing::info!(rings, episodes, "sonar stopped");
-    Ok(())
+
+    fn stopped(&mut self, (_, avoid): &Self::State) {
+        let episodes = avoid.as_ref().map_or(0, |a| a.episodes);
+        tracing::info!(rings = self.rings, episodes, "sonar stopped");
+    }
+}
+
+fn main() -> anyhow::Result<()> {
+    let args = Args::parse();
+    use harvey_geometry::FT;
+    let avoid = (args.avoid_dash_ft > 0.0).then_some(AvoidParams {
+        ttc_s: args.avoid_ttc_s,
+        confirm: args.avoid_confirm,
+        min_approach_mps: args.avoid_min_approach_ftps * FT,
+        arc_rad: std::f64::consts::FRAC_PI_6,
+        turn_rad: args.avoid_turn_deg.to_radians(),
+        dash_m: args.avoid_dash_ft * FT,
+        stop_m: args.panic_stop_ft * FT,
+    });
+    harvey_runtime::node::run("sonar", |p| {
+        Ok(Sonar {
+            raw: p.input(topics::DRV_SONAR_RAW),
+            odometry: p.input(topics::ODOMETRY),
+            ring_out: p.output(topics::SONAR_RING),
+            commands: p.output(topics::VEHICLE_REFLEX),
+            stop_m: args.panic_stop_ft * FT,
+            avoid,
+            banks: Vec::new(),
+            poses: Vec::new(),
+            rings: 0,
+        })
+    })
 }

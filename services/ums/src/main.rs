@@ -4,9 +4,9 @@
 use std::path::PathBuf;
 
 use clap::Parser;
-use harvey_bus::{Bus, Pace, Step, Waiter};
-use harvey_msgs::topics;
-use harvey_runtime::{Rosout, Sent, Throttle};
+use harvey_msgs::{Expectation, LandmarkSighting, Odometry, PoseFix, UncertaintyMap, topics};
+use harvey_runtime::{In, Io, Node, Out, Throttle};
+use harvey_ums::resume::UmsState;
 use harvey_ums::{Config, Output, Ums};
 
 #[derive(Parser)]
@@ -43,20 +43,6 @@ struct Args {
     repeat_warning_s: f64,
 }
 
-/// Sends `m` unless a predecessor of this process sent it before it was killed.
-fn send<T: harvey_msgs::Message>(
-    sent: &mut Sent,
-    port: &harvey_bus::Publisher<T>,
-    m: &T,
-) -> anyhow::Result<()> {
-    let h = *m.header();
-    if sent.due(port.topic(), h.stamp_ns, h.seq) {
-        port.send(m)?;
-        sent.done(port.topic(), h.stamp_ns, h.seq)?;
-    }
-    Ok(())
-}
-
 /// Logs a refusal, unless the same one was logged less than a period ago.
 fn warn(throttle: &mut Throttle, e: &dyn std::fmt::Display, stamp_ns: u64) {
     if let Some(said) = throttle.raise(e.to_string(), stamp_ns) {
@@ -64,11 +50,73 @@ fn warn(throttle: &mut Throttle, e: &dyn std::fmt::Display, stamp_ns: u64) {
     }
 }
 
-/// Room for the map, its history and the pending sightings.
-const SLOT_BYTES: usize = 1 << 20;
+/// The UMS as a node: sightings and fixes first, then the odometry that moves the map on.
+struct UmsNode {
+    odometry: In<Odometry>,
+    sightings: In<LandmarkSighting>,
+    fixes: In<PoseFix>,
+    map_out: Out<UncertaintyMap>,
+    expectations: Out<Expectation>,
+    ums: Ums,
+    repeat_warning_ns: u64,
+    odos: Vec<Odometry>,
+    seen: Vec<LandmarkSighting>,
+    fixed: Vec<PoseFix>,
+}
+
+impl Node for UmsNode {
+    /// The uncertainty and the warnings held back, as the last finished tick left them.
+    type State = (UmsState, Throttle);
+    /// Room for the map, its history and the pending sightings.
+    const CHECKPOINT_BYTES: usize = 1 << 20;
+
+    fn start(&mut self) -> Self::State {
+        (self.ums.state(), Throttle::new(self.repeat_warning_ns))
+    }
+
+    fn resumed(&mut self, (state, _): &mut Self::State) {
+        self.ums.restore(state.clone());
+        let area_m2 = harvey_ums::geometry::area(&self.ums.map().polygon);
+        tracing::warn!(area_m2, "resumed from the checkpoint");
+    }
+
+    fn step(&mut self, (state, warnings): &mut Self::State, io: &mut Io<'_>) -> anyhow::Result<()> {
+        io.take(self.sightings, &mut self.seen)?;
+        for s in &self.seen {
+            if let Err(e) = self.ums.on_sighting(s) {
+                warn(warnings, &e, s.header.stamp_ns);
+            }
+        }
+        io.take(self.fixes, &mut self.fixed)?;
+        for f in &self.fixed {
+            if let Err(e) = self.ums.on_fix(f) {
+                warn(warnings, &e, f.header.stamp_ns);
+            }
+        }
+        io.take(self.odometry, &mut self.odos)?;
+        for o in &self.odos {
+            match self.ums.on_odometry(o) {
+                Ok(out) => {
+                    for x in out {
+                        match x {
+                            Output::Map(m) => io.send(self.map_out, &m)?,
+                            Output::Expectation(e) => io.send(self.expectations, &e)?,
+                            Output::Rejected(e) => warn(warnings, &e, o.header.stamp_ns),
+                        }
+                    }
+                }
+                Err(e) => warn(warnings, &e, o.header.stamp_ns),
+            }
+        }
+        for said in warnings.expire(io.now()) {
+            tracing::warn!("rejected: {said}");
+        }
+        *state = self.ums.state();
+        Ok(())
+    }
+}
 
 fn main() -> anyhow::Result<()> {
-    harvey_runtime::init_logging();
     let args = Args::parse();
     anyhow::ensure!(
         args.sigmas > 0.0 && args.lost_area_m2 > 0.0,
@@ -79,89 +127,32 @@ fn main() -> anyhow::Result<()> {
         "--repeat-warning-s must be a duration in seconds, not {}",
         args.repeat_warning_s
     );
-    let mut world = harvey_world::World::load(&args.world)?;
-    if let Some(start) = args.start {
-        world.start = start;
-    }
-    let image_px = (world.camera.width_px, world.camera.height_px);
-    let config = Config {
-        sigmas: args.sigmas,
-        lost_area_m2: args.lost_area_m2,
-        lost_after_misses: args.lost_after_misses,
-        history_ns: args.history_ms * 1_000_000,
-        image_px,
-        fix_m: args.fix_m,
-        fix_heading_rad: args.fix_heading_deg.to_radians(),
-    };
-    let bus = Bus::join("ums")?;
-    let odometry = bus.subscriber(topics::ODOMETRY)?;
-    let sightings = bus.subscriber(topics::VISION_SIGHTINGS)?;
-    let fixes = bus.subscriber(topics::EXECUTIVE_POSE)?;
-    let map_pub = bus.publisher(topics::UMS_MAP)?;
-    let expectations = bus.publisher(topics::UMS_EXPECTATIONS)?;
-    let mut rosout = Rosout::new(&bus, "ums")?;
-    let pace = Pace::from_env(&bus)?;
-    let waiter = Waiter::new()?;
-    let _a = pace.attach(&waiter, &[&odometry, &sightings, &fixes])?;
-    harvey_runtime::notify_ready()?;
-
-    let mut ums = Ums::new(world, config);
-    // The uncertainty and the warnings held back as the last finished tick left them, for a
-    // restarted UMS.
-    let throttle = Throttle::new((args.repeat_warning_s * 1e9) as u64);
-    let mut resume = harvey_runtime::Resume::from_env("ums", SLOT_BYTES, || (ums.state(), throttle))?;
-    let mut sent = Sent::from_env("ums")?;
-    if resume.resumed() {
-        ums.restore(resume.state().0.clone());
-        tracing::warn!(
-            area_m2 = harvey_ums::geometry::area(&ums.map().polygon),
-            "resumed from the checkpoint"
-        );
-    }
-    let mut warnings = resume.state().1.clone();
-    let (mut odos, mut seen, mut fixed) = (Vec::new(), Vec::new(), Vec::new());
-    let mut newest = 0;
-    while let Step::Go(tick) = pace.next(&waiter, None)? {
-        rosout.begin();
-        sightings.drain_into(&mut seen)?;
-        seen.retain(|m| resume.fresh(sightings.topic(), m.header.stamp_ns, m.header.seq));
-        for s in &seen {
-            if let Err(e) = ums.on_sighting(s) {
-                warn(&mut warnings, &e, s.header.stamp_ns);
-            }
+    harvey_runtime::node::run("ums", |p| {
+        let mut world = harvey_world::World::load(&args.world)?;
+        if let Some(start) = args.start {
+            world.start = start;
         }
-        fixes.drain_into(&mut fixed)?;
-        fixed.retain(|m| resume.fresh(fixes.topic(), m.header.stamp_ns, m.header.seq));
-        for f in &fixed {
-            if let Err(e) = ums.on_fix(f) {
-                warn(&mut warnings, &e, f.header.stamp_ns);
-            }
-        }
-        odometry.drain_into(&mut odos)?;
-        odos.retain(|m| resume.fresh(odometry.topic(), m.header.stamp_ns, m.header.seq));
-        newest = odos.iter().map(|o| o.header.stamp_ns).fold(newest, u64::max);
-        for o in &odos {
-            match ums.on_odometry(o) {
-                Ok(out) => {
-                    for x in out {
-                        match x {
-                            Output::Map(m) => send(&mut sent, &map_pub, &m)?,
-                            Output::Expectation(e) => send(&mut sent, &expectations, &e)?,
-                            Output::Rejected(e) => warn(&mut warnings, &e, o.header.stamp_ns),
-                        }
-                    }
-                }
-                Err(e) => warn(&mut warnings, &e, o.header.stamp_ns),
-            }
-        }
-        let now = tick.unwrap_or(newest);
-        for said in warnings.expire(now) {
-            tracing::warn!("rejected: {said}");
-        }
-        rosout.end(now)?;
-        *resume.state() = (ums.state(), warnings.clone());
-        resume.tick_done()?;
-        pace.done()?;
-    }
-    Ok(())
+        let image_px = (world.camera.width_px, world.camera.height_px);
+        let config = Config {
+            sigmas: args.sigmas,
+            lost_area_m2: args.lost_area_m2,
+            lost_after_misses: args.lost_after_misses,
+            history_ns: args.history_ms * 1_000_000,
+            image_px,
+            fix_m: args.fix_m,
+            fix_heading_rad: args.fix_heading_deg.to_radians(),
+        };
+        Ok(UmsNode {
+            odometry: p.input(topics::ODOMETRY),
+            sightings: p.input(topics::VISION_SIGHTINGS),
+            fixes: p.input(topics::EXECUTIVE_POSE),
+            map_out: p.output(topics::UMS_MAP),
+            expectations: p.output(topics::UMS_EXPECTATIONS),
+            ums: Ums::new(world, config),
+            repeat_warning_ns: (args.repeat_warning_s * 1e9) as u64,
+            odos: Vec::new(),
+            seen: Vec::new(),
+            fixed: Vec::new(),
+        })
+    })
 }

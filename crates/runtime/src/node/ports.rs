@@ -1,0 +1,104 @@
+//! A node's declared ports: typed handles for the node, and what each runner needs to open them.
+
+use core::marker::PhantomData;
+
+use harvey_bus::Bus;
+use harvey_msgs::Message;
+use harvey_msgs::topics::Topic;
+
+/// An input of a node: messages of type `T` from one topic.
+pub struct In<T> {
+    pub(crate) index: usize,
+    pub(crate) topic: &'static str,
+    _t: PhantomData<fn() -> T>,
+}
+
+/// An output of a node: messages of type `T` to one topic.
+pub struct Out<T> {
+    pub(crate) index: usize,
+    pub(crate) topic: &'static str,
+    _t: PhantomData<fn() -> T>,
+}
+
+impl<T> Clone for In<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for In<T> {}
+impl<T> Clone for Out<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+impl<T> Copy for Out<T> {}
+
+impl<T> In<T> {
+    pub fn topic(&self) -> &'static str {
+        self.topic
+    }
+}
+
+impl<T> Out<T> {
+    pub fn topic(&self) -> &'static str {
+        self.topic
+    }
+}
+
+/// An input as a runner opens it.
+pub(crate) trait InputSpec {
+    fn topic(&self) -> &'static str;
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn super::bus::BusInput>>;
+}
+
+/// An output as a runner opens it.
+pub(crate) trait OutputSpec {
+    fn topic(&self) -> &'static str;
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn super::bus::BusOutput>>;
+}
+
+impl<T: Message> InputSpec for Topic<T> {
+    fn topic(&self) -> &'static str {
+        self.name
+    }
+
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn super::bus::BusInput>> {
+        Ok(Box::new(bus.subscriber::<T>(*self)?))
+    }
+}
+
+impl<T: Message> OutputSpec for Topic<T> {
+    fn topic(&self) -> &'static str {
+        self.name
+    }
+
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn super::bus::BusOutput>> {
+        Ok(Box::new(bus.publisher::<T>(*self)?))
+    }
+}
+
+/// What a node declares: its inputs, in the order it takes them, and its outputs.
+#[derive(Default)]
+pub struct Ports {
+    pub(crate) inputs: Vec<Box<dyn InputSpec>>,
+    pub(crate) outputs: Vec<Box<dyn OutputSpec>>,
+}
+
+impl Ports {
+    /// Declares an input; the node takes its messages with [`super::Io::take`].
+    pub fn input<T: Message>(&mut self, topic: Topic<T>) -> In<T> {
+        self.inputs.push(Box::new(topic));
+        In { index: self.inputs.len() - 1, topic: topic.name, _t: PhantomData }
+    }
+
+    /// Declares an output; the node sends on it with [`super::Io::send`].
+    pub fn output<T: Message>(&mut self, topic: Topic<T>) -> Out<T> {
+        self.outputs.push(Box::new(topic));
+        Out { index: self.outputs.len() - 1, topic: topic.name, _t: PhantomData }
+    }
+
+    /// The topics declared, inputs then outputs (for errors and listings).
+    pub fn topics(&self) -> (Vec<&'static str>, Vec<&'static str>) {
+        (self.inputs.iter().map(|i| i.topic()).collect(), self.outputs.iter().map(|o| o.topic()).collect())
+    }
+}
