@@ -41,7 +41,7 @@ impl Node for Encoders {
     }
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> anyhow::Result<std::process::ExitCode> {
     harvey_runtime::node::run("encoders", |p| {
         Ok(Encoders {
             raw: p.input(topics::DRV_ENCODERS_RAW),

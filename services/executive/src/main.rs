@@ -5,10 +5,14 @@
 use std::path::PathBuf;
 
 use clap::Parser;
-use harvey_bus::{Bus, Pace, Step, Waiter};
+use std::process::ExitCode;
+
 use harvey_executive::{Executive, Output, setup};
-use harvey_msgs::{MissionState, Odometry, SonarRing, UncertaintyMap, VisionResult, topics};
-use harvey_runtime::{Journal, Marks, Sent};
+use harvey_msgs::{
+    BehaviourState, Detections, Message, MissionState, MissionStatus, MotionCommand, Odometry, PlanSketch,
+    PoseFix, ServoCorrection, SonarRing, UncertaintyMap, VisionRequest, VisionResult, topics,
+};
+use harvey_runtime::{End, In, Io, Journal, Node, Out};
 
 #[derive(Parser)]
 #[command(about = "Mission executive")]
@@ -22,20 +26,6 @@ struct Args {
     /// Seed of the noise motor schema.
     #[arg(long, default_value_t = 1)]
     seed: u64,
-}
-
-/// Sends `m` unless a predecessor of this process sent it before it was killed.
-fn send<T: harvey_msgs::Message>(
-    sent: &mut Sent,
-    port: &harvey_bus::Publisher<T>,
-    m: &T,
-) -> anyhow::Result<()> {
-    let h = *m.header();
-    if sent.due(port.topic(), h.stamp_ns, h.seq) {
-        port.send(m)?;
-        sent.done(port.topic(), h.stamp_ns, h.seq)?;
-    }
-    Ok(())
 }
 
 /// One tick's inputs, as the executive takes them.
@@ -76,32 +66,20 @@ impl Journaled {
         }
     }
 
-    /// The tick back, its messages noted taken.
-    fn decode(&self, marks: &mut Marks) -> anyhow::Result<Tick> {
-        fn back<T: harvey_cdr::Cdr + harvey_msgs::Message>(
-            v: &[Vec<u8>],
-            topic: &str,
-            marks: &mut Marks,
-        ) -> anyhow::Result<Vec<T>> {
+    /// The tick back.
+    fn decode(&self) -> anyhow::Result<Tick> {
+        fn back<T: harvey_cdr::Cdr>(v: &[Vec<u8>], topic: &str) -> anyhow::Result<Vec<T>> {
             v.iter()
-                .map(|b| {
-                    let m: T =
-                        harvey_cdr::decode(b).map_err(|e| anyhow::anyhow!("the journal's {topic}: {e}"))?;
-                    marks.fresh(topic, m.header().stamp_ns, m.header().seq);
-                    Ok(m)
-                })
+                .map(|b| harvey_cdr::decode(b).map_err(|e| anyhow::anyhow!("the journal's {topic}: {e}")))
                 .collect()
         }
-        if let Some((stamp, seq)) = self.newest_detection {
-            marks.fresh(topics::VISION_DETECTIONS.name, stamp, seq);
-        }
         Ok(Tick {
-            rings: back(&self.rings, topics::SONAR_RING.name, marks)?,
+            rings: back(&self.rings, topics::SONAR_RING.name)?,
             detections: self.detections,
             newest_detection: self.newest_detection,
-            maps: back(&self.maps, topics::UMS_MAP.name, marks)?,
-            results: back(&self.results, topics::VISION_RESULTS.name, marks)?,
-            odos: back(&self.odos, topics::ODOMETRY.name, marks)?,
+            maps: back(&self.maps, topics::UMS_MAP.name)?,
+            results: back(&self.results, topics::VISION_RESULTS.name)?,
+            odos: back(&self.odos, topics::ODOMETRY.name)?,
         })
     }
 }
@@ -125,83 +103,82 @@ fn step(exec: &mut Executive, t: &Tick) -> Vec<Output> {
     out
 }
 
-fn main() -> anyhow::Result<()> {
-    harvey_runtime::init_logging();
-    let args = Args::parse();
-    let loaded = setup::load(&args.mission, args.world.as_deref(), args.seed)?;
-    let mission = &loaded.mission;
-    tracing::info!(description = %mission.description, steps = mission.steps.len(), "mission loaded");
-    let mut exec = loaded.executive;
+/// The executive as a node: its inputs in the order it takes them, its outputs, and the journal
+/// a restarted executive is rebuilt from.
+struct ExecutiveNode {
+    sonar: In<SonarRing>,
+    detections: In<Detections>,
+    maps: In<UncertaintyMap>,
+    results: In<VisionResult>,
+    odometry: In<Odometry>,
+    commands: Out<MotionCommand>,
+    status: Out<MissionStatus>,
+    requests: Out<VisionRequest>,
+    servo: Out<ServoCorrection>,
+    pose: Out<PoseFix>,
+    behaviour: Out<BehaviourState>,
+    plan: Out<PlanSketch>,
+    exec: Executive,
+    journal: Option<Journal>,
+    tick: Tick,
+    seen: Vec<Detections>,
+}
 
-    let bus = Bus::join("executive")?;
-    let odometry = bus.subscriber(topics::ODOMETRY)?;
-    let sonar = bus.subscriber(topics::SONAR_RING)?;
-    let detections = bus.subscriber(topics::VISION_DETECTIONS)?;
-    let maps = bus.subscriber(topics::UMS_MAP)?;
-    let results = bus.subscriber(topics::VISION_RESULTS)?;
-    let commands = bus.publisher(topics::VEHICLE_COMMAND)?;
-    let status = bus.publisher(topics::EXECUTIVE_STATUS)?;
-    let requests = bus.publisher(topics::VISION_REQUESTS)?;
-    let servo_pub = bus.publisher(topics::EXECUTIVE_SERVO)?;
-    let pose_pub = bus.publisher(topics::EXECUTIVE_POSE)?;
-    let behaviour_pub = bus.publisher(topics::EXECUTIVE_BEHAVIOUR)?;
-    let plan_pub = bus.publisher(topics::EXECUTIVE_PLAN)?;
-    let mut rosout = harvey_runtime::Rosout::new(&bus, "executive")?;
-    let pace = Pace::from_env(&bus)?;
-    let waiter = Waiter::new()?;
-    let _a = pace.attach(&waiter, &[&odometry, &sonar, &detections, &maps, &results])?;
-    harvey_runtime::notify_ready()?;
-
-    // A restarted executive is rebuilt by running its predecessor's inputs through it again
-    // (its plans and behaviours are too rich to checkpoint; the logic is deterministic).
-    let mut marks = Marks::default();
-    let mut journal = match Journal::from_env::<Journaled>("executive")? {
-        Some((journal, past)) => {
-            if !past.is_empty() {
-                let ticks = past.len();
-                for j in past {
-                    let tick = j.decode(&mut marks)?;
-                    let _ = step(&mut exec, &tick);
-                }
-                tracing::warn!(ticks, state = ?exec.state(), "resumed: the inputs of the ticks before run through again");
-            }
-            Some(journal)
+impl ExecutiveNode {
+    /// Notes a journaled tick's messages taken, so that their re-offers are not taken again.
+    fn mark(&self, io: &mut Io<'_>, t: &Tick) {
+        fn all<T: Message>(io: &mut Io<'_>, input: In<T>, msgs: &[T]) {
+            msgs.iter().for_each(|m| io.mark_taken(input, m.header().stamp_ns, m.header().seq));
         }
-        None => None,
-    };
-    let mut sent = Sent::from_env("executive")?;
-    let mut tick = Tick::default();
-    let mut latest_ns = 0;
-    while exec.state() == MissionState::Running {
-        let turn = match pace.next(&waiter, None)? {
-            Step::Go(turn) => turn,
-            Step::Idle => continue,
-            Step::Stop => {
-                tracing::warn!("stopped before the mission ended");
-                return Ok(());
-            }
+        all(io, self.sonar, &t.rings);
+        if let Some((s, q)) = t.newest_detection {
+            io.mark_taken(self.detections, s, q);
+        }
+        all(io, self.maps, &t.maps);
+        all(io, self.results, &t.results);
+        all(io, self.odometry, &t.odos);
+    }
+}
+
+impl Node for ExecutiveNode {
+    /// Nothing is checkpointed: plans and behaviours are too rich, so a restarted executive runs
+    /// its predecessor's inputs through again (the logic is deterministic).
+    type State = ();
+    const CHECKPOINT_BYTES: usize = 0;
+
+    fn start(&mut self) {}
+
+    fn begin(&mut self, _: &mut (), _: bool, io: &mut Io<'_>) -> anyhow::Result<()> {
+        let Some((journal, past)) = Journal::from_env::<Journaled>("executive")? else {
+            return Ok(());
         };
-        rosout.begin();
-        let fresh =
-            |marks: &mut Marks, topic: &str, h: &harvey_msgs::Header| marks.fresh(topic, h.stamp_ns, h.seq);
-        sonar.drain_into(&mut tick.rings)?;
-        tick.rings.retain(|m| fresh(&mut marks, sonar.topic(), &m.header));
-        let (mut n, mut newest) = (0, None);
-        detections.drain(|d| {
-            if fresh(&mut marks, detections.topic(), &d.header) {
-                (n, newest) = (n + 1, Some((d.header.stamp_ns, d.header.seq)));
+        self.journal = Some(journal);
+        if !past.is_empty() {
+            let ticks = past.len();
+            for j in past {
+                let tick = j.decode()?;
+                self.mark(io, &tick);
+                let _ = step(&mut self.exec, &tick);
             }
-        })?;
-        (tick.detections, tick.newest_detection) = (n, newest);
-        maps.drain_into(&mut tick.maps)?;
-        tick.maps.retain(|m| fresh(&mut marks, maps.topic(), &m.header));
-        results.drain_into(&mut tick.results)?;
-        tick.results.retain(|m| fresh(&mut marks, results.topic(), &m.header));
-        odometry.drain_into(&mut tick.odos)?;
-        tick.odos.retain(|m| fresh(&mut marks, odometry.topic(), &m.header));
-        latest_ns = tick.odos.iter().map(|o| o.header.stamp_ns).fold(latest_ns, u64::max);
-        let out = step(&mut exec, &tick);
-        for o in &out {
+            tracing::warn!(ticks, state = ?self.exec.state(), "resumed: the inputs of the ticks before run through again");
+        }
+        Ok(())
+    }
+
+    fn finished(&self, _: &()) -> bool {
+        self.exec.state() != MissionState::Running
+    }
+
+    fn step(&mut self, _: &mut (), io: &mut Io<'_>) -> anyhow::Result<()> {
+        let t = &mut self.tick;
+        io.take(self.sonar, &mut t.rings)?;
+        io.take(self.detections, &mut self.seen)?;
+        t.detections = self.seen.len() as u64;
+        t.newest_detection = self.seen.last().map(|d| (d.header.stamp_ns, d.header.seq));
+        io.take(self.maps, &mut t.maps)?;
+        io.take(self.results, &mut t.results)?;
+        io.take(self.odometry, &mut t.odos)?;
+        for o in step(&mut self.exec, t) {
             match o {
                 Output::Command(c) => {
                     tracing::debug!(
@@ -211,39 +188,60 @@ fn main() -> anyhow::Result<()> {
                         angle_rad = c.angle_rad,
                         "command"
                     );
-                    send(&mut sent, &commands, c)?;
+                    io.send(self.commands, &c)?;
                 }
-                Output::Look(r) => {
-                    send(&mut sent, &requests, r)?;
-                }
-                Output::Status(s) => {
-                    send(&mut sent, &status, s)?;
-                }
-                Output::Servo(c) => {
-                    send(&mut sent, &servo_pub, c)?;
-                }
-                Output::Pose(p) => {
-                    send(&mut sent, &pose_pub, p)?;
-                }
-                Output::Plan(p) => {
-                    send(&mut sent, &plan_pub, p)?;
-                }
-                Output::Behaviour(b) => {
-                    send(&mut sent, &behaviour_pub, b)?;
-                }
+                Output::Look(r) => io.send(self.requests, &r)?,
+                Output::Status(s) => io.send(self.status, &s)?,
+                Output::Servo(c) => io.send(self.servo, &c)?,
+                Output::Pose(p) => io.send(self.pose, &p)?,
+                Output::Plan(p) => io.send(self.plan, &p)?,
+                Output::Behaviour(b) => io.send(self.behaviour, &b)?,
             }
         }
-        rosout.end(turn.unwrap_or(latest_ns))?;
-        if let Some(j) = journal.as_mut() {
-            j.append(&Journaled::encode(&tick))?;
+        if let Some(j) = self.journal.as_mut() {
+            j.append(&Journaled::encode(&self.tick))?;
         }
-        pace.done()?;
+        Ok(())
     }
-    summarise(&exec)
+
+    fn stopped(&mut self, _: &(), end: End) -> anyhow::Result<u8> {
+        if end == End::Stopped {
+            tracing::warn!("stopped before the mission ended");
+            return Ok(0);
+        }
+        Ok(summarise(&self.exec))
+    }
 }
 
-/// Logs the servoed legs and exits as the mission ended.
-fn summarise(exec: &Executive) -> anyhow::Result<()> {
+fn main() -> anyhow::Result<ExitCode> {
+    let args = Args::parse();
+    harvey_runtime::node::run("executive", |p| {
+        let loaded = setup::load(&args.mission, args.world.as_deref(), args.seed)?;
+        let mission = &loaded.mission;
+        tracing::info!(description = %mission.description, steps = mission.steps.len(), "mission loaded");
+        Ok(ExecutiveNode {
+            sonar: p.input(topics::SONAR_RING),
+            detections: p.input(topics::VISION_DETECTIONS),
+            maps: p.input(topics::UMS_MAP),
+            results: p.input(topics::VISION_RESULTS),
+            odometry: p.input(topics::ODOMETRY),
+            commands: p.output(topics::VEHICLE_COMMAND),
+            status: p.output(topics::EXECUTIVE_STATUS),
+            requests: p.output(topics::VISION_REQUESTS),
+            servo: p.output(topics::EXECUTIVE_SERVO),
+            pose: p.output(topics::EXECUTIVE_POSE),
+            behaviour: p.output(topics::EXECUTIVE_BEHAVIOUR),
+            plan: p.output(topics::EXECUTIVE_PLAN),
+            exec: loaded.executive,
+            journal: None,
+            tick: Tick::default(),
+            seen: Vec::new(),
+        })
+    })
+}
+
+/// Logs the servoed legs; the exit code as the mission ended (0 succeeded, 3 failed).
+fn summarise(exec: &Executive) -> u8 {
     for (k, leg) in exec.legs().iter().enumerate() {
         let worst = leg.corrections.iter().map(|c| c.1.abs()).fold(0.0, f64::max);
         tracing::info!(
@@ -257,11 +255,11 @@ fn summarise(exec: &Executive) -> anyhow::Result<()> {
     match exec.state() {
         MissionState::Succeeded => {
             tracing::info!("mission succeeded");
-            Ok(())
+            0
         }
         _ => {
             tracing::error!("mission failed");
-            std::process::exit(3)
+            3
         }
     }
 }

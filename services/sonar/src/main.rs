@@ -4,7 +4,7 @@
 
 use clap::Parser;
 use harvey_msgs::{MotionCommand, Odometry, SonarRaw, SonarRing, topics};
-use harvey_runtime::{In, Io, Node, Out};
+use harvey_runtime::{End, In, Io, Node, Out};
 use harvey_sonar::SonarRingBuilder;
 use harvey_sonar::avoid::{AvoidParams, PanicAvoid};
 
@@ -86,13 +86,14 @@ impl Node for Sonar {
         Ok(())
     }
 
-    fn stopped(&mut self, (_, avoid): &Self::State) {
+    fn stopped(&mut self, (_, avoid): &Self::State, _: End) -> anyhow::Result<u8> {
         let episodes = avoid.as_ref().map_or(0, |a| a.episodes);
         tracing::info!(rings = self.rings, episodes, "sonar stopped");
+        Ok(0)
     }
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> anyhow::Result<std::process::ExitCode> {
     let args = Args::parse();
     use harvey_geometry::FT;
     let avoid = (args.avoid_dash_ft > 0.0).then_some(AvoidParams {

@@ -74,10 +74,13 @@ impl Node for UmsNode {
         (self.ums.state(), Throttle::new(self.repeat_warning_ns))
     }
 
-    fn resumed(&mut self, (state, _): &mut Self::State) {
-        self.ums.restore(state.clone());
-        let area_m2 = harvey_ums::geometry::area(&self.ums.map().polygon);
-        tracing::warn!(area_m2, "resumed from the checkpoint");
+    fn begin(&mut self, (state, _): &mut Self::State, resumed: bool, _: &mut Io<'_>) -> anyhow::Result<()> {
+        if resumed {
+            self.ums.restore(state.clone());
+            let area_m2 = harvey_ums::geometry::area(&self.ums.map().polygon);
+            tracing::warn!(area_m2, "resumed from the checkpoint");
+        }
+        Ok(())
     }
 
     fn step(&mut self, (state, warnings): &mut Self::State, io: &mut Io<'_>) -> anyhow::Result<()> {
@@ -116,7 +119,7 @@ impl Node for UmsNode {
     }
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> anyhow::Result<std::process::ExitCode> {
     let args = Args::parse();
     anyhow::ensure!(
         args.sigmas > 0.0 && args.lost_area_m2 > 0.0,

@@ -6,9 +6,12 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use clap::Parser;
-use harvey_bus::{Bus, Pace, Step, Waiter};
-use harvey_msgs::{Expectation, VisionAlgorithm, VisionRequest, topics};
-use harvey_runtime::{Resume, Sent};
+use std::process::ExitCode;
+
+use harvey_msgs::{
+    Detections, Expectation, LandmarkSighting, VisionAlgorithm, VisionRequest, VisionResult, topics,
+};
+use harvey_runtime::{End, FrameIn, In, Io, Node, Out};
 use harvey_vision_workers::VerticalEdges;
 use harvey_vision_workers::dispatch::Dispatcher;
 use harvey_vision_workers::landmarks::LineLandmarks;
@@ -53,154 +56,156 @@ fn shard(text: &str) -> anyhow::Result<(u32, u32)> {
     }
 }
 
-/// Sends `m` unless a predecessor of this process sent it before it was killed.
-fn send<T: harvey_msgs::Message>(
-    sent: &mut Sent,
-    port: &harvey_bus::Publisher<T>,
-    m: &T,
-) -> anyhow::Result<()> {
-    let h = *m.header();
-    if sent.due(port.topic(), h.stamp_ns, h.seq) {
-        port.send(m)?;
-        sent.done(port.topic(), h.stamp_ns, h.seq)?;
-    }
-    Ok(())
-}
-
-/// Room for the requests and expectations in force.
-const SLOT_BYTES: usize = 256 << 10;
-
 /// What a worker keeps from tick to tick.
 #[derive(Default, serde::Serialize, serde::Deserialize)]
 struct Kept {
+    /// Requests by id (ascending, so answers come in a fixed order); one-shot ones go once
+    /// answered.
     asked: BTreeMap<u32, VisionRequest>,
     wanted: BTreeMap<u32, Expectation>,
     /// The detector's, the landmark recogniser's and the dispatcher's numbering.
     numbered: [u64; 3],
 }
 
-/// The tick is done: what is in force is saved.
-fn keep(
-    resume: &mut Resume<Kept>,
-    asked: &BTreeMap<u32, VisionRequest>,
-    wanted: &BTreeMap<u32, Expectation>,
-    numbered: [u64; 3],
-) -> anyhow::Result<()> {
-    let kept = resume.state();
-    (kept.asked, kept.wanted, kept.numbered) = (asked.clone(), wanted.clone(), numbered);
-    Ok(resume.tick_done()?)
+/// The vision workers as a node: expectations and requests first, then the newest frame.
+struct Workers {
+    frames: FrameIn,
+    expectations: In<Expectation>,
+    requests: In<VisionRequest>,
+    detections: Out<Detections>,
+    sightings: Out<LandmarkSighting>,
+    request_out: Out<VisionRequest>,
+    results: Out<VisionResult>,
+    /// This worker's share of the requests: ids K modulo N.
+    shard: (u32, u32),
+    /// The standing `--lines` request of this worker's own.
+    own: Option<VisionRequest>,
+    landmarks: bool,
+    max_age_ns: u64,
+    camera: harvey_world::Camera,
+    dispatcher: Dispatcher,
+    edges: VerticalEdges,
+    lines: LineLandmarks,
+    new_expectations: Vec<Expectation>,
+    new_requests: Vec<VisionRequest>,
+    processed: u64,
+    found: u64,
 }
 
-fn main() -> anyhow::Result<()> {
-    harvey_runtime::init_logging();
+impl Node for Workers {
+    /// What a restarted worker takes back: the requests and expectations in force and its
+    /// numbering. (The region tracker's and activity detector's frames are not kept: a
+    /// restarted worker's begin afresh.)
+    type State = Kept;
+    /// Room for the requests and expectations in force.
+    const CHECKPOINT_BYTES: usize = 256 << 10;
+
+    fn start(&mut self) -> Kept {
+        Kept { asked: self.own.iter().map(|r| (r.request_id, *r)).collect(), ..Kept::default() }
+    }
+
+    fn begin(&mut self, kept: &mut Kept, resumed: bool, io: &mut Io<'_>) -> anyhow::Result<()> {
+        if resumed {
+            self.edges.number_from(kept.numbered[0]);
+            self.lines.number_from(kept.numbered[1]);
+            self.dispatcher.number_from(kept.numbered[2]);
+            let (requests, expectations) = (kept.asked.len(), kept.wanted.len());
+            tracing::warn!(requests, expectations, "resumed from the checkpoint");
+        } else if let Some(own) = &self.own {
+            // Published so the recording shows what was asked (once: not again by a restarted
+            // worker); answered like any other.
+            io.send(self.request_out, own)?;
+        }
+        Ok(())
+    }
+
+    fn step(&mut self, kept: &mut Kept, io: &mut Io<'_>) -> anyhow::Result<()> {
+        io.take(self.expectations, &mut self.new_expectations)?;
+        kept.wanted.extend(self.new_expectations.iter().map(|e| (e.landmark_index, *e)));
+        io.take(self.requests, &mut self.new_requests)?;
+        let (k, n) = self.shard;
+        kept.asked
+            .extend(self.new_requests.iter().filter(|r| r.request_id % n == k).map(|r| (r.request_id, *r)));
+        if let Some(frame) = io.latest_frame(self.frames)? {
+            let (h, pixels) = (*frame.header(), frame.pixels());
+            match self.edges.run(&h, pixels) {
+                Ok(d) => {
+                    io.send(self.detections, &d)?;
+                    self.processed += 1;
+                }
+                Err(e) => tracing::warn!("skipping a frame: {e}"),
+            }
+            self.lines.focal_px = self.camera.focal_for(h.width_px);
+            kept.wanted.retain(|_, e| e.header.stamp_ns + self.max_age_ns >= h.stamp_ns);
+            for e in kept.wanted.values().filter(|_| self.landmarks) {
+                if let Some(s) = self.lines.recognise(&h, pixels, e) {
+                    self.found += u64::from(s.kind != 0);
+                    io.send(self.sightings, &s)?;
+                }
+            }
+            for req in kept.asked.values() {
+                io.send(self.results, &self.dispatcher.answer(&h, pixels, req))?;
+            }
+            kept.asked.retain(|_, r| r.standing != 0);
+        }
+        kept.numbered = [self.edges.numbered(), self.lines.numbered(), self.dispatcher.numbered()];
+        Ok(())
+    }
+
+    fn stopped(&mut self, _: &Kept, _: End) -> anyhow::Result<u8> {
+        tracing::info!(processed = self.processed, found = self.found, "vision workers stopped");
+        Ok(0)
+    }
+}
+
+/// The `--lines` request: the fast line finder on every frame, as request 1.
+fn own_request(args: &Args) -> anyhow::Result<Option<VisionRequest>> {
+    let Some(range) = &args.lines else {
+        return Ok(None);
+    };
+    anyhow::ensure!(range.len() == 2, "--lines takes LO,HI in degrees; got {range:?}");
+    let mut own = VisionRequest {
+        request_id: 1,
+        algorithm: VisionAlgorithm::LineFinder as u32,
+        standing: 1,
+        ..Default::default()
+    };
+    own.params[4..6].copy_from_slice(range);
+    if let Some(win) = &args.lines_window {
+        anyhow::ensure!(win.len() == 4, "--lines-window takes U0,V0,U1,V1; got {win:?}");
+        own.window_px.copy_from_slice(win);
+    }
+    Ok(Some(own))
+}
+
+fn main() -> anyhow::Result<ExitCode> {
     let args = Args::parse();
-    let world = harvey_world::World::load(&args.world)?;
-    let bus = Bus::join("vision-workers")?;
-    let frames = bus.frame_subscriber(topics::CAMERA_FRAME)?;
-    let expectations = bus.subscriber(topics::UMS_EXPECTATIONS)?;
-    let detections = bus.publisher(topics::VISION_DETECTIONS)?;
-    let sightings = bus.publisher(topics::VISION_SIGHTINGS)?;
-    let requests = bus.subscriber(topics::VISION_REQUESTS)?;
-    let request_pub = bus.publisher(topics::VISION_REQUESTS)?;
-    let results = bus.publisher(topics::VISION_RESULTS)?;
-    let (k, n) = shard(&args.shard)?;
-    let pace = Pace::from_env(&bus)?;
-    let waiter = Waiter::new()?;
-    let _a = pace.attach(&waiter, &[&frames, &expectations, &requests])?;
-    harvey_runtime::notify_ready()?;
-
-    // What a restarted worker takes back from its checkpoint: the requests and expectations in
-    // force and its numbering. (The region tracker's and activity detector's frames are not
-    // kept: a restarted worker's begin afresh.)
-    let mut resume = Resume::from_env("vision-workers", SLOT_BYTES, Kept::default)?;
-    let mut sent = Sent::from_env("vision-workers")?;
-    // Requests by id (ascending, so answers come in a fixed order); one-shot ones go once answered.
-    let mut asked: BTreeMap<u32, VisionRequest> = BTreeMap::new();
-    if let Some(range) = &args.lines {
-        anyhow::ensure!(range.len() == 2, "--lines takes LO,HI in degrees; got {range:?}");
-        let mut own = VisionRequest {
-            request_id: 1,
-            algorithm: VisionAlgorithm::LineFinder as u32,
-            standing: 1,
-            ..Default::default()
-        };
-        own.params[4..6].copy_from_slice(range);
-        if let Some(win) = &args.lines_window {
-            anyhow::ensure!(win.len() == 4, "--lines-window takes U0,V0,U1,V1; got {win:?}");
-            own.window_px.copy_from_slice(win);
-        }
-        // Published so the recording shows what was asked (once: not again by a restarted
-        // worker); answered like any other.
-        if !resume.resumed() {
-            request_pub.send(&own)?;
-        }
-        asked.insert(own.request_id, own);
-    }
-    let mut dispatcher = Dispatcher::new(world.clone());
-
-    let mut edges = VerticalEdges::new(args.band_half_rows, args.edge_threshold);
-    let mut lines = LineLandmarks::new(world.camera.focal_px, args.edge_threshold)
-        .with_calibration_sd(world.survey.calibration_sd_rad)
-        .with_blur(world.camera.blur_px);
-    let mut wanted: BTreeMap<u32, Expectation> = BTreeMap::new();
-    if resume.resumed() {
-        let kept = resume.state();
-        (asked, wanted) = (kept.asked.clone(), kept.wanted.clone());
-        edges.number_from(kept.numbered[0]);
-        lines.number_from(kept.numbered[1]);
-        dispatcher.number_from(kept.numbered[2]);
-        tracing::warn!(requests = asked.len(), expectations = wanted.len(), "resumed from the checkpoint");
-    }
-    let max_age_ns = args.expectation_max_age_ms * 1_000_000;
-    let mut rosout = harvey_runtime::Rosout::new(&bus, "vision-workers")?;
-    let (mut processed, mut found, mut newest) = (0u64, 0u64, 0);
-    while let Step::Go(tick) = pace.next(&waiter, None)? {
-        rosout.begin();
-        expectations.drain(|e| {
-            if resume.fresh(expectations.topic(), e.header.stamp_ns, e.header.seq) {
-                wanted.insert(e.landmark_index, *e);
-            }
-        })?;
-        requests.drain(|r| {
-            if r.request_id % n == k && resume.fresh(requests.topic(), r.header.stamp_ns, r.header.seq) {
-                asked.insert(r.request_id, *r);
-            }
-        })?;
-        // Work on the newest frame only: a late worker skips, it does not fall further behind.
-        let frame =
-            frames.latest()?.filter(|f| resume.fresh(frames.topic(), f.header().stamp_ns, f.header().seq));
-        let Some(frame) = frame else {
-            rosout.end(tick.unwrap_or(newest))?;
-            keep(&mut resume, &asked, &wanted, [edges.numbered(), lines.numbered(), dispatcher.numbered()])?;
-            pace.done()?;
-            continue;
-        };
-        let h = *frame.header();
-        newest = newest.max(h.stamp_ns);
-        match edges.run(&h, frame.pixels()) {
-            Ok(d) => {
-                send(&mut sent, &detections, &d)?;
-                processed += 1;
-            }
-            Err(e) => tracing::warn!("skipping a frame: {e}"),
-        }
-        lines.focal_px = world.camera.focal_for(h.width_px);
-        wanted.retain(|_, e| e.header.stamp_ns + max_age_ns >= h.stamp_ns);
-        for e in wanted.values().filter(|_| args.landmarks) {
-            if let Some(s) = lines.recognise(&h, frame.pixels(), e) {
-                found += u64::from(s.kind != 0);
-                send(&mut sent, &sightings, &s)?;
-            }
-        }
-        for req in asked.values() {
-            send(&mut sent, &results, &dispatcher.answer(&h, frame.pixels(), req))?;
-        }
-        asked.retain(|_, r| r.standing != 0);
-        drop(frame);
-        rosout.end(tick.unwrap_or(newest))?;
-        keep(&mut resume, &asked, &wanted, [edges.numbered(), lines.numbered(), dispatcher.numbered()])?;
-        pace.done()?;
-    }
-    tracing::info!(processed, found, "vision workers stopped");
-    Ok(())
+    let shard = shard(&args.shard)?;
+    let own = own_request(&args)?;
+    harvey_runtime::node::run("vision-workers", |p| {
+        let world = harvey_world::World::load(&args.world)?;
+        Ok(Workers {
+            frames: p.frames(topics::CAMERA_FRAME),
+            expectations: p.input(topics::UMS_EXPECTATIONS),
+            requests: p.input(topics::VISION_REQUESTS),
+            detections: p.output(topics::VISION_DETECTIONS),
+            sightings: p.output(topics::VISION_SIGHTINGS),
+            request_out: p.output(topics::VISION_REQUESTS),
+            results: p.output(topics::VISION_RESULTS),
+            shard,
+            own,
+            landmarks: args.landmarks,
+            max_age_ns: args.expectation_max_age_ms * 1_000_000,
+            edges: VerticalEdges::new(args.band_half_rows, args.edge_threshold),
+            lines: LineLandmarks::new(world.camera.focal_px, args.edge_threshold)
+                .with_calibration_sd(world.survey.calibration_sd_rad)
+                .with_blur(world.camera.blur_px),
+            dispatcher: Dispatcher::new(world.clone()),
+            camera: world.camera,
+            new_expectations: Vec::new(),
+            new_requests: Vec::new(),
+            processed: 0,
+            found: 0,
+        })
+    })
 }

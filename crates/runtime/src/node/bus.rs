@@ -2,17 +2,26 @@
 //! the clock chain.
 
 use std::any::Any;
+use std::process::ExitCode;
 
-use harvey_bus::{Bus, Pace, Publisher, Step, Subscriber, Waitable, Waiter};
+use harvey_bus::{Bus, FrameSubscriber, Pace, Publisher, Step, Subscriber, Waitable, Waiter};
 use harvey_msgs::Message;
 
-use super::{Io, Node, Ports, Transport, msg_of, vec_of};
+use super::{End, FrameView, Io, Node, Ports, Transport, msg_of, vec_of};
 use crate::{Resume, Rosout, Sent};
 
 /// An input opened on the bus.
 pub(crate) trait BusInput {
-    fn take(&self, out: &mut dyn Any) -> anyhow::Result<()>;
+    fn topic(&self) -> &'static str;
     fn waitable(&self) -> &dyn Waitable;
+
+    fn take(&self, _out: &mut dyn Any) -> anyhow::Result<()> {
+        anyhow::bail!("{}: a frame input is read with `latest_frame`", self.topic())
+    }
+
+    fn latest_frame(&self) -> anyhow::Result<Option<Box<dyn FrameView>>> {
+        anyhow::bail!("{}: a message input is read with `take`", self.topic())
+    }
 }
 
 /// An output opened on the bus.
@@ -21,13 +30,31 @@ pub(crate) trait BusOutput {
 }
 
 impl<T: Message> BusInput for Subscriber<T> {
-    fn take(&self, out: &mut dyn Any) -> anyhow::Result<()> {
-        self.drain_into(vec_of::<T>(out, self.topic())?)?;
-        Ok(())
+    fn topic(&self) -> &'static str {
+        Subscriber::topic(self)
     }
 
     fn waitable(&self) -> &dyn Waitable {
         self
+    }
+
+    fn take(&self, out: &mut dyn Any) -> anyhow::Result<()> {
+        self.drain_into(vec_of::<T>(out, Subscriber::topic(self))?)?;
+        Ok(())
+    }
+}
+
+impl BusInput for FrameSubscriber {
+    fn topic(&self) -> &'static str {
+        FrameSubscriber::topic(self)
+    }
+
+    fn waitable(&self) -> &dyn Waitable {
+        self
+    }
+
+    fn latest_frame(&self) -> anyhow::Result<Option<Box<dyn FrameView>>> {
+        Ok(self.latest()?.map(|f| Box::new(f) as Box<dyn FrameView>))
     }
 }
 
@@ -49,15 +76,23 @@ impl Transport for Wired {
         self.inputs[index].take(out)
     }
 
+    fn latest_frame(&self, index: usize) -> anyhow::Result<Option<Box<dyn FrameView>>> {
+        self.inputs[index].latest_frame()
+    }
+
     fn put(&self, index: usize, msg: &dyn Any) -> anyhow::Result<()> {
         self.outputs[index].put(msg)
     }
 }
 
-/// Runs the node `build` makes as service `name` over the bus, until SIGINT or SIGTERM (in
-/// deterministic mode, once the turns granted have run). `build` declares the node's ports; it
-/// runs after logging is set up, so what it logs is seen.
-pub fn run<N: Node>(name: &str, build: impl FnOnce(&mut Ports) -> anyhow::Result<N>) -> anyhow::Result<()> {
+/// Runs the node `build` makes as service `name` over the bus, until it is finished or told to
+/// stop (SIGINT or SIGTERM; in deterministic mode once the turns granted have run), and
+/// returns the exit code the node gives. `build` declares the node's ports; it runs after
+/// logging is set up, so what it logs is seen.
+pub fn run<N: Node>(
+    name: &str,
+    build: impl FnOnce(&mut Ports) -> anyhow::Result<N>,
+) -> anyhow::Result<ExitCode> {
     crate::init_logging();
     let mut ports = Ports::default();
     let mut node = build(&mut ports)?;
@@ -71,15 +106,28 @@ pub fn run<N: Node>(name: &str, build: impl FnOnce(&mut Ports) -> anyhow::Result
     let waiter = Waiter::new()?;
     let wakes: Vec<&dyn Waitable> = wired.inputs.iter().map(|i| i.waitable()).collect();
     let attachments = pace.attach(&waiter, &wakes)?;
-    let mut resume = Resume::from_env(name, N::CHECKPOINT_BYTES, || node.start())?;
+    let checkpoint = match N::CHECKPOINT_BYTES {
+        0 => None,
+        bytes => crate::Checkpoint::from_env(name, bytes)?,
+    };
+    let mut resume = Resume::with(checkpoint, || node.start())?;
     let mut sent = Sent::from_env(name)?;
-    if resume.resumed() {
-        node.resumed(resume.parts().0);
-    }
     crate::notify_ready()?;
 
     let mut newest = 0;
-    while let Step::Go(tick) = pace.next(&waiter, None)? {
+    let resumed = resume.resumed();
+    let (state, taken) = resume.parts();
+    let mut io = Io { transport: &wired, taken, sent: &mut sent, tick: None, newest: &mut newest };
+    node.begin(state, resumed, &mut io)?;
+    let end = loop {
+        if node.finished(resume.parts().0) {
+            break End::Finished;
+        }
+        let tick = match pace.next(&waiter, None)? {
+            Step::Go(tick) => tick,
+            Step::Idle => continue,
+            Step::Stop => break End::Stopped,
+        };
         rosout.begin();
         let (state, taken) = resume.parts();
         let mut io = Io { transport: &wired, taken, sent: &mut sent, tick, newest: &mut newest };
@@ -88,8 +136,7 @@ pub fn run<N: Node>(name: &str, build: impl FnOnce(&mut Ports) -> anyhow::Result
         rosout.end(now)?;
         resume.tick_done()?;
         pace.done()?;
-    }
+    };
     drop(attachments);
-    node.stopped(resume.parts().0);
-    Ok(())
+    Ok(ExitCode::from(node.stopped(resume.parts().0, end)?))
 }

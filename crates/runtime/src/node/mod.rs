@@ -1,27 +1,35 @@
 //! The node: a service's logic as the runtime runs it, declared ports and one step a turn.
 //!
-//! A service declares its inputs and outputs once ([`Ports`], typed handles [`In`] and [`Out`])
-//! and implements [`Node::step`]: take what came in, work, send what goes out, through [`Io`].
-//! Everything around the step is the runner's, the same for every service: joining the bus,
-//! pacing (real time or its turn in the clock chain), readiness, the checkpoint a restarted
-//! process resumes from ([`crate::Resume`]: inputs already taken are dropped, outputs already
-//! sent are not sent twice), and the turn's warnings on `rosout`. [`run`] runs a node as a
-//! process over the bus.
+//! A service declares its inputs and outputs once ([`Ports`], typed handles [`In`], [`Out`] and
+//! [`FrameIn`]) and implements [`Node::step`]: take what came in, work, send what goes out,
+//! through [`Io`]. Everything around the step is the runner's, the same for every service:
+//! joining the bus, pacing (real time or its turn in the clock chain), readiness, the
+//! checkpoint a restarted process resumes from ([`crate::Resume`]: inputs already taken are
+//! dropped, outputs already sent are not sent twice), and the turn's warnings on `rosout`.
+//! [`run`] runs a node as a process over the bus.
 
 mod bus;
+mod io;
 mod ports;
 
 pub use bus::run;
-pub use ports::{In, Out, Ports};
+pub use io::{FrameView, Io};
+pub use ports::{FrameIn, In, Out, Ports};
 
 use std::any::Any;
 
-use harvey_msgs::Message;
 use serde::Serialize;
 use serde::de::DeserializeOwned;
 
-use crate::Sent;
-use crate::resume::Marks;
+/// How a node's run ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum End {
+    /// The node said it was done ([`Node::finished`]).
+    Finished,
+    /// The runner was told to stop (SIGINT or SIGTERM; in deterministic mode once the turns
+    /// granted have run).
+    Stopped,
+}
 
 /// A service's logic: what it keeps across restarts, and what it does with a turn's inputs.
 ///
@@ -31,73 +39,45 @@ use crate::resume::Marks;
 pub trait Node {
     /// What a restarted process needs to go on where its predecessor stopped.
     type State: Serialize + DeserializeOwned;
-    /// Room for the state and the marks of its inputs in the checkpoint.
+    /// Room for the state and the marks of its inputs in the checkpoint; 0: no checkpoint (a
+    /// node that rebuilds itself otherwise, in [`Node::begin`]).
     const CHECKPOINT_BYTES: usize;
 
     /// The state of a fresh start.
     fn start(&mut self) -> Self::State;
 
-    /// The state came from a predecessor's checkpoint (before the first turn): take it up.
-    fn resumed(&mut self, _state: &mut Self::State) {
-        tracing::warn!("resumed from the checkpoint");
+    /// Once, before the first turn, with the state fresh or (`resumed`) a predecessor's. What a
+    /// node sends here goes out before the first tick.
+    fn begin(&mut self, _state: &mut Self::State, resumed: bool, _io: &mut Io<'_>) -> anyhow::Result<()> {
+        if resumed {
+            tracing::warn!("resumed from the checkpoint");
+        }
+        Ok(())
     }
 
     /// One turn: take the inputs, work, send.
     fn step(&mut self, state: &mut Self::State, io: &mut Io<'_>) -> anyhow::Result<()>;
 
-    /// The service stops, after its last turn: say what it did.
-    fn stopped(&mut self, _state: &Self::State) {}
+    /// Whether the node is done (checked before each turn): the runner stops it.
+    fn finished(&self, _state: &Self::State) -> bool {
+        false
+    }
+
+    /// The service stops, after its last turn: say what it did. The process exits with the
+    /// code returned.
+    fn stopped(&mut self, _state: &Self::State, _end: End) -> anyhow::Result<u8> {
+        Ok(0)
+    }
 }
 
 /// Moves messages between a node and its ports; the runner's transport behind [`Io`].
 pub(crate) trait Transport {
     /// Replaces `out` (a `Vec<T>` of input `index`'s type) with what came in, oldest first.
     fn take(&self, index: usize, out: &mut dyn Any) -> anyhow::Result<()>;
+    /// The newest frame of frame input `index`, older ones released.
+    fn latest_frame(&self, index: usize) -> anyhow::Result<Option<Box<dyn FrameView>>>;
     /// Sends `msg` (a `T` of output `index`'s type).
     fn put(&self, index: usize, msg: &dyn Any) -> anyhow::Result<()>;
-}
-
-/// A node's view of its ports during one turn.
-pub struct Io<'a> {
-    transport: &'a dyn Transport,
-    taken: &'a mut Marks,
-    sent: &'a mut Sent,
-    tick: Option<u64>,
-    newest: &'a mut u64,
-}
-
-impl Io<'_> {
-    /// Replaces `out` with the messages that came in on `input` since the last turn, oldest first,
-    /// less those a predecessor of this process had taken already. Reuse `out` across turns.
-    pub fn take<T: Message>(&mut self, input: In<T>, out: &mut Vec<T>) -> anyhow::Result<()> {
-        self.transport.take(input.index, out)?;
-        let taken = &mut *self.taken;
-        out.retain(|m| taken.fresh(input.topic, m.header().stamp_ns, m.header().seq));
-        *self.newest = out.iter().map(|m| m.header().stamp_ns).fold(*self.newest, u64::max);
-        Ok(())
-    }
-
-    /// Sends `msg` on `output`, unless a predecessor of this process sent it before it was killed.
-    pub fn send<T: Message>(&mut self, output: Out<T>, msg: &T) -> anyhow::Result<()> {
-        self.send_as(output, output.topic, msg)
-    }
-
-    /// [`Io::send`] for an output whose messages `key` numbers apart from the others sent on
-    /// the same topic (two reflexes, each numbering its own commands).
-    pub fn send_as<T: Message>(&mut self, output: Out<T>, key: &str, msg: &T) -> anyhow::Result<()> {
-        let h = *msg.header();
-        if self.sent.due(key, h.stamp_ns, h.seq) {
-            self.transport.put(output.index, msg)?;
-            self.sent.done(key, h.stamp_ns, h.seq)?;
-        }
-        Ok(())
-    }
-
-    /// The turn's time: the tick in deterministic mode; in real time the newest stamp taken so
-    /// far (of this turn or an earlier one).
-    pub fn now(&self) -> u64 {
-        self.tick.unwrap_or(*self.newest)
-    }
 }
 
 /// `out` as the `Vec<T>` a port of type `T` fills, or an error naming the topic.

@@ -4,7 +4,9 @@ use core::marker::PhantomData;
 
 use harvey_bus::Bus;
 use harvey_msgs::Message;
-use harvey_msgs::topics::Topic;
+use harvey_msgs::topics::{FrameTopic, Topic};
+
+use super::bus::{BusInput, BusOutput};
 
 /// An input of a node: messages of type `T` from one topic.
 pub struct In<T> {
@@ -18,6 +20,13 @@ pub struct Out<T> {
     pub(crate) index: usize,
     pub(crate) topic: &'static str,
     _t: PhantomData<fn() -> T>,
+}
+
+/// A frame input of a node: camera frames read in place.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameIn {
+    pub(crate) index: usize,
+    pub(crate) topic: &'static str,
 }
 
 impl<T> Clone for In<T> {
@@ -48,13 +57,13 @@ impl<T> Out<T> {
 /// An input as a runner opens it.
 pub(crate) trait InputSpec {
     fn topic(&self) -> &'static str;
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn super::bus::BusInput>>;
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>>;
 }
 
 /// An output as a runner opens it.
 pub(crate) trait OutputSpec {
     fn topic(&self) -> &'static str;
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn super::bus::BusOutput>>;
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusOutput>>;
 }
 
 impl<T: Message> InputSpec for Topic<T> {
@@ -62,8 +71,18 @@ impl<T: Message> InputSpec for Topic<T> {
         self.name
     }
 
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn super::bus::BusInput>> {
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>> {
         Ok(Box::new(bus.subscriber::<T>(*self)?))
+    }
+}
+
+impl InputSpec for FrameTopic {
+    fn topic(&self) -> &'static str {
+        self.name
+    }
+
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>> {
+        Ok(Box::new(bus.frame_subscriber(*self)?))
     }
 }
 
@@ -72,7 +91,7 @@ impl<T: Message> OutputSpec for Topic<T> {
         self.name
     }
 
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn super::bus::BusOutput>> {
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusOutput>> {
         Ok(Box::new(bus.publisher::<T>(*self)?))
     }
 }
@@ -89,6 +108,12 @@ impl Ports {
     pub fn input<T: Message>(&mut self, topic: Topic<T>) -> In<T> {
         self.inputs.push(Box::new(topic));
         In { index: self.inputs.len() - 1, topic: topic.name, _t: PhantomData }
+    }
+
+    /// Declares a frame input; the node reads its frames with [`super::Io::latest_frame`].
+    pub fn frames(&mut self, topic: FrameTopic) -> FrameIn {
+        self.inputs.push(Box::new(topic));
+        FrameIn { index: self.inputs.len() - 1, topic: topic.name }
     }
 
     /// Declares an output; the node sends on it with [`super::Io::send`].
