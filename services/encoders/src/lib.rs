@@ -2,6 +2,7 @@
 //! carries the commanded motion and the progress made on it, for the UMS's growth and the
 //! executive's monitoring.
 
+pub mod node;
 use harvey_geometry::wrap;
 use harvey_msgs::{EncodersRaw, Header, MotionCommand, Odometry, Pose2};
 

@@ -6,6 +6,7 @@
 
 pub mod behaviours;
 pub mod mission;
+pub mod node;
 pub mod plan;
 pub mod script;
 pub mod servo;

@@ -4,6 +4,7 @@
 
 pub mod approach;
 pub mod avoid;
+pub mod node;
 
 use harvey_msgs::PANIC_STOP_IDS;
 use harvey_msgs::{CommandKind, Header, MotionCommand, SONAR_BANK_SIZE, SONAR_SENSORS, SonarRaw, SonarRing};

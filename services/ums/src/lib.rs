@@ -11,6 +11,7 @@ pub mod expecter;
 mod fix;
 pub mod geometry;
 pub mod map;
+pub mod node;
 pub mod reduction;
 pub mod resume;
 

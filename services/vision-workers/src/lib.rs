@@ -1,6 +1,7 @@
 //! Vision workers' logic. This first worker finds vertical edges (door frames, wall corners) in a
 //! horizontal band of the frame, read in place; the papers' algorithms join it in their issue.
 
+pub mod node;
 use harvey_msgs::{Detections, Feature, FrameHeader, Header, MAX_FEATURES};
 
 /// Algorithm ids carried in [`Detections::algorithm`].
