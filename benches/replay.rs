@@ -2,7 +2,9 @@
 //! hallway, 26 s of simulated time) against real time, and beside it the live deterministic run
 //! of the same mission, measured in the same run, once per vision-kernel SIMD path the CPU has
 //! (`HARVEY_SIMD`, which the services inherit), so what the kernels' paths bring to a whole
-//! mission is a same-run ratio. Target: replay ≥ 50x real time.
+//! mission is a same-run ratio; and the replay in one process (`--in-process`), whose ratio to
+//! the multi-process replay is same-run too. Targets: replay ≥ 50x real time; in process ≥ 10x
+//! the multi-process replay and ≥ 500x real time (issue 15).
 //!
 //! `cargo build --release --workspace && cargo bench --bench replay`
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
@@ -32,10 +34,12 @@ fn timed(path: SimdPath, args: &[&str]) -> (f64, String) {
     (wall, text)
 }
 
-/// The speed the replayer reports: "replay finished: 57.8x real time".
+/// The speed the replayer reports: "replay finished: 57.8x real time"; in process, the line
+/// "replay: N ticks, ...: 90.6x real time".
 fn replay_factor(text: &str) -> f64 {
-    text.split("replay finished: ")
-        .nth(1)
+    let line = text.lines().find(|l| l.starts_with("replay: ") && l.ends_with("x real time"));
+    line.map(|l| l.rsplit(": ").next().unwrap_or(l))
+        .or_else(|| text.split("replay finished: ").nth(1))
         .and_then(|t| t.split('x').next())
         .and_then(|x| x.trim().parse().ok())
         .unwrap_or_else(|| panic!("no replay figure in:\n{text}"))
@@ -51,6 +55,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 struct Figures {
     replay: Vec<f64>,
     replay_wall: Vec<f64>,
+    inproc: Vec<f64>,
+    inproc_wall: Vec<f64>,
     live: Vec<f64>,
 }
 
@@ -80,6 +86,20 @@ fn main() {
             assert!(text.contains("identical: "), "the replay on {path} differs:\n{text}");
             figures[k].replay.push(replay_factor(&text));
             figures[k].replay_wall.push(sim_s / wall);
+            let (wall, text) = timed(
+                path,
+                &[
+                    "replay",
+                    reference.to_str().expect("utf8"),
+                    "--check",
+                    "--in-process",
+                    "--run-dir",
+                    replay_dir.to_str().expect("utf8"),
+                ],
+            );
+            assert!(text.contains("identical: "), "the in-process replay on {path} differs:\n{text}");
+            figures[k].inproc.push(replay_factor(&text));
+            figures[k].inproc_wall.push(sim_s / wall);
             let (wall, _) = timed(
                 path,
                 &[
@@ -109,7 +129,20 @@ fn main() {
     };
     row("replay, ticks fed to the tail's last report (replayer's figure)", &|f| f.replay.clone());
     row("replay, whole command (start-up, check, shutdown included)", &|f| f.replay_wall.clone());
+    row("replay in process, first tick to the last turn (the replay's figure)", &|f| f.inproc.clone());
+    row("replay in process, whole command (check included)", &|f| f.inproc_wall.clone());
     row("live deterministic run with rendering, whole command", &|f| f.live.clone());
+    let met = |ok: bool| if ok { "met" } else { "NOT met" };
     let best = figures.last().map_or(0.0, |f| median(f.replay.clone()));
-    println!("target ≥ 50x on the fastest path: {}", if best >= 50.0 { "met" } else { "NOT met" });
+    println!("target ≥ 50x on the fastest path: {}", met(best >= 50.0));
+    for (f, p) in figures.iter().zip(&paths) {
+        let (multi, one) = (median(f.replay.clone()), median(f.inproc.clone()));
+        let ratio = one / multi;
+        println!(
+            "{p}: in process / multi-process (the replays' figures, same run) = {ratio:.2}x (target ≥ 10x: {}); \
+             in process {one:.1}x real time (target ≥ 500x: {})",
+            met(ratio >= 10.0),
+            met(one >= 500.0)
+        );
+    }
 }

@@ -125,6 +125,47 @@ fn the_reference_recording_replays_exactly() {
 }
 
 #[test]
+fn the_reference_recording_replays_exactly_in_one_process() {
+    let reference = common::repo().join("recordings/reference/default.mcap");
+    let (out, _, dir) = common::replay_check_with(&reference, "replay-inproc", &["--in-process"]);
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out));
+    let bytes = std::fs::read(&reference).expect("reference");
+    let summary = mcap::Summary::read(&bytes).expect("summary").expect("present");
+    let recorded = summary.stats.expect("statistics").message_count as usize;
+    assert_eq!(agreed(&out), recorded, "{}", text(&out));
+    // It says how fast it went and where the time went, party by party.
+    let said = text(&out);
+    assert!(said.contains("x real time") && said.contains("turns: replayer"), "{said}");
+    for party in ["sonar", "encoders", "vision-workers", "ums", "executive", "recorder"] {
+        assert!(said.contains(&format!(", {party} ")), "{party}: {said}");
+    }
+    // A launch with a service that has no node for in-process runs is refused, naming it and
+    // the services that do.
+    let launch = std::fs::read_to_string(common::repo().join("missions/default.toml")).expect("default")
+        + "\n[[service]]\nname = \"foxglove-bridge\"\n";
+    let mut rec = harvey_recording::Recorder::create(&dir.join("odd.mcap")).expect("create");
+    rec.attach_launch("odd.toml", &launch).expect("launch");
+    rec.attach_world(
+        "w.toml",
+        &std::fs::read_to_string(common::repo().join("worlds/hallway.toml")).expect("world"),
+        1,
+    )
+    .expect("world");
+    rec.finish().expect("finish");
+    let odd = common::harvey(&["replay", "--in-process", dir.join("odd.mcap").to_str().expect("utf8")])
+        .args(["--run-dir", dir.join("odd").to_str().expect("utf8")])
+        .output()
+        .expect("runs");
+    assert_eq!(odd.status.code(), Some(2), "{}", text(&odd));
+    assert!(
+        text(&odd).contains("service foxglove-bridge (harvey-foxglove-bridge) has no node registered for in-process runs; these can run in process: harvey-sonar"),
+        "{}",
+        text(&odd)
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
 fn a_clock_party_killed_mid_run_is_resumed_and_the_mission_ends() {
     let (prefix, dir) = (common::unique_prefix("det-kill"), common::scratch("det-kill"));
     let mut child = common::harvey(&[

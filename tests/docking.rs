@@ -68,6 +68,12 @@ fn docking_recovers_from_the_occluding_cart_and_ends_within_several_inches() {
     assert_eq!(common::agreed(&replay), Some(count), "{said}");
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
     let _ = std::fs::remove_dir_all(&dir);
+    // And as nodes of one process, the FSA sequencer's acceptor table and all.
+    let (replay, _, dir) = common::replay_check_with(&out.dir.join("run.mcap"), "dockip", &["--in-process"]);
+    let said = String::from_utf8_lossy(&replay.stdout);
+    assert_eq!(replay.status.code(), Some(0), "{said}\n{}", String::from_utf8_lossy(&replay.stderr));
+    assert_eq!(common::agreed(&replay), Some(count), "{said}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

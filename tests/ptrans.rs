@@ -104,6 +104,15 @@ fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
     let off_in = (end.x_m - 12.0).hypot(end.y_m - 2.5) / INCH;
     println!("ends {off_in:.2} in from the goal, heading {:.2} deg", end.heading_rad.to_degrees());
     assert!(off_in < 1.0, "ends {off_in:.2} in from the goal");
+    // Replayed as nodes of one process, the services give back every message of the run.
+    let (replay, _, dir) =
+        common::replay_check_with(&out.dir.join("run.mcap"), "ptransip", &["--in-process"]);
+    let said = String::from_utf8_lossy(&replay.stdout);
+    assert_eq!(replay.status.code(), Some(0), "{said}\n{}", String::from_utf8_lossy(&replay.stderr));
+    let summary = mcap::Summary::read(&out.mcap).expect("summary").expect("present");
+    let count = summary.stats.expect("stats").message_count as usize;
+    assert_eq!(common::agreed(&replay), Some(count), "{said}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// The run's final distance from the goal (in), as the mission report gives it.

@@ -107,4 +107,17 @@ fn every_warning_a_service_printed_is_on_rosout_once_stamped_with_a_tick() {
         String::from_utf8_lossy(&out.stdout)
     );
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
+    // In one process the nodes' warnings are captured and numbered the same way.
+    let (out, _, _) = common::replay_check_with(&recording, "rosout-inproc", &["--in-process"]);
+    assert!(
+        out.status.success(),
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        common::agreed(&out).is_some_and(|n| n >= lines.len()),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
 }

@@ -5,6 +5,7 @@ pub mod chaos;
 pub mod diff;
 pub mod export;
 pub mod info;
+mod inproc;
 pub mod launch;
 mod live;
 pub mod recover;

@@ -13,9 +13,20 @@ use super::{LaunchArgs, launch_file, report_comparison};
 /// the new recording and Rerun file (as the launches name them), the world and the launch.
 const WRITTEN: [&str; 4] = ["run.mcap", "run.rrd", "world.toml", LAUNCH_FILE];
 
-/// `trust`: start whatever binaries the recording's launch file names (`--trust-recording`);
-/// without it only Harvey's own service binaries.
-pub fn run(recording: &Path, check: bool, rrd: bool, trust: bool, opts: LaunchArgs) -> anyhow::Result<i32> {
+/// How a replay runs.
+pub struct How {
+    /// Compare the new recording with the old.
+    pub check: bool,
+    /// Draw the new recording into a Rerun file.
+    pub rrd: bool,
+    /// Start whatever binaries the recording's launch file names (`--trust-recording`); without
+    /// it only Harvey's own service binaries.
+    pub trust: bool,
+    /// Run the services as nodes of this process instead of processes over shared memory.
+    pub in_process: bool,
+}
+
+pub fn run(recording: &Path, how: How, opts: LaunchArgs) -> anyhow::Result<i32> {
     // Every argument is checked before anything is written.
     harvey_bus::validate_prefix(&opts.prefix)?;
     anyhow::ensure!(
@@ -26,14 +37,33 @@ pub fn run(recording: &Path, check: bool, rrd: bool, trust: bool, opts: LaunchAr
         opts.run_dir.clone().unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
     refuse_writing_over(recording, &run_dir)?;
     // A live view is drawn from the Rerun file's stream.
-    let file = prepare(recording, &run_dir, rrd || opts.live.is_some(), trust)?;
-    println!("replaying: {} (the launch {} carries)", file.display(), recording.display());
-    let (outcome, _) = launch_file(&file, &LaunchArgs { run_dir: Some(run_dir.clone()), ..opts })?;
-    println!("replay: {outcome:?}");
+    let file = prepare(recording, &run_dir, how.rrd || opts.live.is_some(), how.trust)?;
     let again = run_dir.join("run.mcap");
+    if how.in_process {
+        println!("replaying in process: {} (the launch {} carries)", file.display(), recording.display());
+        let r = super::inproc::replay(recording, &file, &run_dir)?;
+        println!(
+            "replay: {} ticks, {} messages, {:.2} s of the run in {:.3} s: {:.1}x real time",
+            r.ticks,
+            r.messages,
+            r.sim_s,
+            r.wall_s,
+            r.sim_s / r.wall_s.max(1e-9)
+        );
+        let turns: Vec<String> = r.turns.iter().map(|(p, s)| format!("{p} {:.1} ms", s * 1e3)).collect();
+        println!("turns: {}", turns.join(", "));
+    } else {
+        println!("replaying: {} (the launch {} carries)", file.display(), recording.display());
+        let (outcome, _) = launch_file(&file, &LaunchArgs { run_dir: Some(run_dir.clone()), ..opts })?;
+        println!("replay: {outcome:?}");
+        if outcome.exit_code() != 0 {
+            println!("recording: {}", again.display());
+            return Ok(outcome.exit_code());
+        }
+    }
     println!("recording: {}", again.display());
-    if outcome.exit_code() != 0 || !check {
-        return Ok(outcome.exit_code());
+    if !how.check {
+        return Ok(0);
     }
     let c = harvey_recording::compare::compare(recording, &again, &|_| true)?;
     Ok(report_comparison(&c, recording, &again))
@@ -88,7 +118,8 @@ mod tests {
             live: None,
             foxglove: None,
         };
-        assert!(run(&recording, false, false, false, opts).is_err(), "a bad prefix is refused");
+        let how = How { check: false, rrd: false, trust: false, in_process: false };
+        assert!(run(&recording, how, opts).is_err(), "a bad prefix is refused");
         assert!(!dir.join("other").exists(), "before anything is written");
         std::fs::remove_dir_all(&dir).ok();
     }

@@ -179,6 +179,16 @@ pub fn holds(m: &harvey_msgs::UncertaintyMap, x: f64, y: f64, th: f64, tol: f64)
 /// `harvey replay --check` of `recording`, under its own bus prefix and scratch run folder.
 #[allow(dead_code)]
 pub fn replay_check(recording: &Path, tag: &str) -> (std::process::Output, String, PathBuf) {
+    replay_check_with(recording, tag, &[])
+}
+
+/// [`replay_check`] with more arguments (`--in-process`).
+#[allow(dead_code)]
+pub fn replay_check_with(
+    recording: &Path,
+    tag: &str,
+    more: &[&str],
+) -> (std::process::Output, String, PathBuf) {
     let (prefix, dir) = (unique_prefix(tag), scratch(tag));
     let out = harvey(&[
         "replay",
@@ -189,6 +199,7 @@ pub fn replay_check(recording: &Path, tag: &str) -> (std::process::Output, Strin
         "--run-dir",
         dir.to_str().expect("utf8"),
     ])
+    .args(more)
     .output()
     .expect("replay runs");
     (out, prefix, dir)

@@ -37,6 +37,7 @@ pub mod same_file;
 mod stream;
 mod summary;
 pub mod ticks;
+pub mod topics;
 pub mod writer;
 
 pub use attachments::DataFile;

@@ -92,6 +92,11 @@ impl<S: Serialize + DeserializeOwned> Resume<S> {
         (&mut self.state, &mut self.taken)
     }
 
+    /// Whether a checkpoint is kept (the supervisor gave a state folder).
+    pub fn keeps(&self) -> bool {
+        self.checkpoint.is_some()
+    }
+
     /// Whether an input on `topic` is news to the state (and notes it taken).
     pub fn fresh(&mut self, topic: &str, stamp_ns: u64, seq: u64) -> bool {
         self.taken.fresh(topic, stamp_ns, seq)
@@ -120,6 +125,11 @@ impl Sent {
         let mut checkpoint = Checkpoint::from_env(&format!("{service}-sent"), 16 << 10)?;
         let marks = checkpoint.as_mut().map(|c| c.load::<Marks>()).transpose()?.flatten().unwrap_or_default();
         Ok(Self { checkpoint, marks })
+    }
+
+    /// No predecessor and no checkpoint (a node run in process).
+    pub fn detached() -> Self {
+        Self { checkpoint: None, marks: Marks::default() }
     }
 
     /// Whether a message on `topic` (or another key that numbers its own) still has to go out.

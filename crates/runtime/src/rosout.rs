@@ -112,7 +112,8 @@ impl Numbering {
 
 /// A service's `rosout` publisher.
 pub struct Rosout {
-    port: Publisher<LogLine>,
+    /// None: a node run in process, whose runner takes the lines ([`Rosout::end_with`]).
+    port: Option<Publisher<LogLine>>,
     name: String,
     numbering: Numbering,
     checkpoint: Option<Checkpoint>,
@@ -128,8 +129,22 @@ impl Rosout {
         let mut checkpoint = Checkpoint::from_env(&format!("{name}-rosout"), 1024)?;
         let numbering =
             checkpoint.as_mut().map(|c| c.load::<Numbering>()).transpose()?.flatten().unwrap_or_default();
-        let port = bus.publisher(topics::ROSOUT)?;
+        let port = Some(bus.publisher(topics::ROSOUT)?);
         Ok(Self { port, name: name.to_owned(), numbering, checkpoint, first_turn: true, held: Vec::new() })
+    }
+
+    /// Service `name`'s lines for a runner that delivers them itself (in process): no bus, no
+    /// checkpoint.
+    pub fn detached(name: &str) -> Self {
+        let numbering = Numbering::default();
+        Self {
+            port: None,
+            name: name.to_owned(),
+            numbering,
+            checkpoint: None,
+            first_turn: true,
+            held: Vec::new(),
+        }
     }
 
     /// A turn begins: this thread's WARN and ERROR events are captured from now on (what was
@@ -151,6 +166,21 @@ impl Rosout {
     /// The turn ends: what was captured goes out stamped `stamp_ns` (the tick in deterministic
     /// mode; in real time the newest input the turn took). Returns the lines sent.
     pub fn end(&mut self, stamp_ns: u64) -> anyhow::Result<usize> {
+        let port = self.port.take();
+        let sent = self.end_with(stamp_ns, |line| {
+            port.as_ref().map(|p| p.send(line)).transpose()?;
+            Ok(())
+        });
+        self.port = port;
+        sent
+    }
+
+    /// [`Rosout::end`], each line handed to `send` (a detached service's runner delivers them).
+    pub fn end_with(
+        &mut self,
+        stamp_ns: u64,
+        mut send: impl FnMut(&LogLine) -> anyhow::Result<()>,
+    ) -> anyhow::Result<usize> {
         let mut lines = std::mem::take(&mut self.held);
         lines.extend(CAPTURED.with(|c| c.borrow_mut().take()).unwrap_or_default());
         let first_turn = std::mem::replace(&mut self.first_turn, false);
@@ -163,7 +193,7 @@ impl Rosout {
             let seq = self.numbering.next;
             self.numbering.next += 1;
             if self.numbering.due(stamp_ns, seq) {
-                self.port.send(&LogLine::new(Header::new(seq, stamp_ns), level, &self.name, &text))?;
+                send(&LogLine::new(Header::new(seq, stamp_ns), level, &self.name, &text))?;
                 self.numbering.sent = Some((stamp_ns, seq));
                 sent += 1;
             }

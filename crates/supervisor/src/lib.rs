@@ -35,6 +35,6 @@ pub use keeper::{Kept, keep};
 pub use keeper_line::KeeperLine;
 pub use outcome::{Options, Outcome};
 pub use policy::{Decision, Restart, RestartPolicy, RestartRules};
-pub use slots::find_binary;
+pub use slots::{expand_args, find_binary, variables};
 pub use supervisor::run;
 pub use wait::NotReady;

@@ -57,6 +57,33 @@ pub fn find_binary(name: &str) -> Option<PathBuf> {
     beside.into_iter().chain(on_path).find(|p| p.is_file())
 }
 
+/// The values a launch file's `${...}` stand for: the run folder, seed, launch file, bus prefix
+/// and world (which must exist).
+pub fn variables(
+    launch: &LaunchFile,
+    run_dir: &Path,
+    prefix: &str,
+) -> Result<Vec<(&'static str, String)>, SupervisorError> {
+    let mut vars = vec![
+        ("run_dir", absolute(run_dir).display().to_string()),
+        ("seed", launch.settings.seed.to_string()),
+        ("mission", absolute(&launch.path).display().to_string()),
+        ("prefix", prefix.to_owned()),
+    ];
+    if let Some(w) = launch.world_path() {
+        if !w.is_file() {
+            return Err(SupervisorError::NoWorld { launch: launch.path.clone(), world: w });
+        }
+        vars.push(("world", absolute(&w).display().to_string()));
+    }
+    Ok(vars)
+}
+
+/// A service's arguments with the launch's `${...}` substituted.
+pub fn expand_args(service: &Service, vars: &[(&str, String)]) -> Vec<String> {
+    service.args.iter().map(|a| substitute(a, vars)).collect()
+}
+
 fn substitute(arg: &str, vars: &[(&str, String)]) -> String {
     vars.iter().fold(arg.to_owned(), |a, (k, v)| a.replace(&format!("${{{k}}}"), v))
 }
@@ -84,18 +111,7 @@ pub fn prepare(
         _ => std::fs::create_dir_all(&state_dir),
     };
     made.map_err(|source| SupervisorError::RunDir { path: state_dir.clone(), source })?;
-    let mut vars = vec![
-        ("run_dir", absolute(&opts.run_dir).display().to_string()),
-        ("seed", launch.settings.seed.to_string()),
-        ("mission", absolute(&launch.path).display().to_string()),
-        ("prefix", opts.prefix.clone()),
-    ];
-    if let Some(w) = launch.world_path() {
-        if !w.is_file() {
-            return Err(SupervisorError::NoWorld { launch: launch.path.clone(), world: w });
-        }
-        vars.push(("world", absolute(&w).display().to_string()));
-    }
+    let vars = variables(launch, &opts.run_dir, &opts.prefix)?;
     let clock_mode = launch.settings.clock.as_str();
     // Check every binary before starting anything.
     let mut slots = Vec::new();
@@ -116,7 +132,7 @@ pub fn prepare(
             service: s.name().to_owned(),
             binary: bin.clone(),
         })?;
-        let args = s.args.iter().map(|a| substitute(a, &vars)).collect();
+        let args = expand_args(s, &vars);
         slots.push(Slot {
             spec: s.clone(),
             binary,

@@ -16,6 +16,7 @@ use harvey_msgs::{Message, Topic, topics};
 use harvey_recording::derive::{self, Deriver};
 use harvey_recording::draw::draw_recorded;
 use harvey_recording::rrd::RrdWriter;
+use harvey_recording::topics::{TopicVisitor, visit_message_topics};
 use harvey_recording::{ChunkCompression, Recorder, carry_over, data_files};
 
 mod taps;
@@ -105,9 +106,20 @@ impl From<Compression> for ChunkCompression {
     }
 }
 
-fn tap<T: Message + Ros2Msg>(bus: &Bus, rec: &mut Recorder, topic: Topic<T>) -> anyhow::Result<Box<dyn Tap>> {
-    let channel = rec.channel::<T>(topic.name)?;
-    Ok(Box::new(MsgTap { sub: bus.subscriber(topic)?, channel }))
+/// Builds a tap (and its channel) for each recorded message topic, in the recorder's order.
+struct Taps<'a> {
+    bus: &'a Bus,
+    rec: &'a mut Recorder,
+    taps: Vec<Box<dyn Tap>>,
+}
+
+impl TopicVisitor for Taps<'_> {
+    type Error = anyhow::Error;
+    fn message<T: Message + Ros2Msg>(&mut self, topic: Topic<T>) -> anyhow::Result<()> {
+        let channel = self.rec.channel::<T>(topic.name)?;
+        self.taps.push(Box::new(MsgTap { sub: self.bus.subscriber(topic)?, channel }));
+        Ok(())
+    }
 }
 
 fn main() -> anyhow::Result<()> {
@@ -158,28 +170,13 @@ fn main() -> anyhow::Result<()> {
         args.rrd.as_ref().map(|p| RrdWriter::create_live(p, world.as_ref(), live.as_deref())).transpose()?;
     let bus = Bus::join("recorder")?;
     let frame_channel = rec.image_channel(topics::CAMERA_FRAME.name)?;
-    let taps: Vec<Box<dyn Tap>> = vec![
-        tap(&bus, &mut rec, topics::SIM_TRUTH)?,
-        tap(&bus, &mut rec, topics::DRV_SONAR_RAW)?,
-        tap(&bus, &mut rec, topics::DRV_ENCODERS_RAW)?,
-        tap(&bus, &mut rec, topics::VEHICLE_COMMAND)?,
-        tap(&bus, &mut rec, topics::VEHICLE_REFLEX)?,
-        tap(&bus, &mut rec, topics::SONAR_RING)?,
-        tap(&bus, &mut rec, topics::ODOMETRY)?,
-        tap(&bus, &mut rec, topics::VISION_DETECTIONS)?,
-        tap(&bus, &mut rec, topics::UMS_MAP)?,
-        tap(&bus, &mut rec, topics::VISION_SIGHTINGS)?,
-        tap(&bus, &mut rec, topics::UMS_EXPECTATIONS)?,
-        tap(&bus, &mut rec, topics::EXECUTIVE_STATUS)?,
-        tap(&bus, &mut rec, topics::EXECUTIVE_SERVO)?,
-        tap(&bus, &mut rec, topics::EXECUTIVE_POSE)?,
-        tap(&bus, &mut rec, topics::EXECUTIVE_PLAN)?,
-        tap(&bus, &mut rec, topics::EXECUTIVE_BEHAVIOUR)?,
-        tap(&bus, &mut rec, topics::VISION_REQUESTS)?,
-        tap(&bus, &mut rec, topics::VISION_RESULTS)?,
-        tap(&bus, &mut rec, topics::ROSOUT)?,
-        Box::new(FrameTap { sub: bus.frame_subscriber(topics::CAMERA_FRAME)?, channel: frame_channel }),
-    ];
+    let mut taps = Taps { bus: &bus, rec: &mut rec, taps: Vec::new() };
+    visit_message_topics(&mut taps)?;
+    let mut taps = taps.taps;
+    taps.push(Box::new(FrameTap {
+        sub: bus.frame_subscriber(topics::CAMERA_FRAME)?,
+        channel: frame_channel,
+    }));
     let recorded: Vec<&str> = rec.stats().map(|s| s.topic.as_str()).collect();
     let missing: Vec<&&str> = topics::ALL.iter().filter(|t| !recorded.contains(t)).collect();
     anyhow::ensure!(missing.is_empty(), "the recorder has no tap for {missing:?}");

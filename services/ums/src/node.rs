@@ -81,7 +81,7 @@ impl Node for UmsNode {
         Ok(())
     }
 
-    fn step(&mut self, (state, warnings): &mut Self::State, io: &mut Io<'_>) -> anyhow::Result<()> {
+    fn step(&mut self, (_, warnings): &mut Self::State, io: &mut Io<'_>) -> anyhow::Result<()> {
         io.take(self.sightings, &mut self.seen)?;
         for s in &self.seen {
             if let Err(e) = self.ums.on_sighting(s) {
@@ -112,8 +112,11 @@ impl Node for UmsNode {
         for said in warnings.expire(io.now()) {
             tracing::warn!("rejected: {said}");
         }
-        *state = self.ums.state();
         Ok(())
+    }
+
+    fn save(&mut self, (state, _): &mut Self::State) {
+        *state = self.ums.state();
     }
 }
 

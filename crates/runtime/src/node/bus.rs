@@ -134,6 +134,9 @@ pub fn run<N: Node>(
         node.step(state, &mut io)?;
         let now = io.now();
         rosout.end(now)?;
+        if resume.keeps() {
+            node.save(resume.parts().0);
+        }
         resume.tick_done()?;
         pace.done()?;
     };

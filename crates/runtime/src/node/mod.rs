@@ -9,10 +9,13 @@
 //! [`run`] runs a node as a process over the bus.
 
 mod bus;
+mod inproc;
 mod io;
+pub mod memory;
 mod ports;
 
 pub use bus::run;
+pub use inproc::{Hosted, host};
 pub use io::{FrameView, Io};
 pub use ports::{FrameIn, In, Out, Ports};
 
@@ -57,6 +60,10 @@ pub trait Node {
 
     /// One turn: take the inputs, work, send.
     fn step(&mut self, state: &mut Self::State, io: &mut Io<'_>) -> anyhow::Result<()>;
+
+    /// Brings `state` up to date before the runner saves it, at the end of a turn, for a node
+    /// that keeps part of what it needs elsewhere (called only when a checkpoint is kept).
+    fn save(&mut self, _state: &mut Self::State) {}
 
     /// Whether the node is done (checked before each turn): the runner stops it.
     fn finished(&self, _state: &Self::State) -> bool {

@@ -7,6 +7,8 @@ use harvey_msgs::Message;
 use harvey_msgs::topics::{FrameTopic, Topic};
 
 use super::bus::{BusInput, BusOutput};
+use super::inproc::{FrameReceiver, MemInput, MemOutput};
+use super::memory::Hub;
 
 /// An input of a node: messages of type `T` from one topic.
 pub struct In<T> {
@@ -58,12 +60,14 @@ impl<T> Out<T> {
 pub(crate) trait InputSpec {
     fn topic(&self) -> &'static str;
     fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>>;
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemInput>>;
 }
 
 /// An output as a runner opens it.
 pub(crate) trait OutputSpec {
     fn topic(&self) -> &'static str;
     fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusOutput>>;
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemOutput>>;
 }
 
 impl<T: Message> InputSpec for Topic<T> {
@@ -73,6 +77,10 @@ impl<T: Message> InputSpec for Topic<T> {
 
     fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>> {
         Ok(Box::new(bus.subscriber::<T>(*self)?))
+    }
+
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemInput>> {
+        Ok(Box::new(hub.subscribe::<T>(self.name, self.qos.buffer)?))
     }
 }
 
@@ -84,6 +92,10 @@ impl InputSpec for FrameTopic {
     fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>> {
         Ok(Box::new(bus.frame_subscriber(*self)?))
     }
+
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemInput>> {
+        Ok(Box::new(FrameReceiver(hub.subscribe(self.name, self.qos.buffer)?)))
+    }
 }
 
 impl<T: Message> OutputSpec for Topic<T> {
@@ -93,6 +105,10 @@ impl<T: Message> OutputSpec for Topic<T> {
 
     fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusOutput>> {
         Ok(Box::new(bus.publisher::<T>(*self)?))
+    }
+
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemOutput>> {
+        Ok(Box::new(hub.publisher::<T>(self.name, self.qos.buffer)?))
     }
 }
 

@@ -1,0 +1,179 @@
+//! Nodes hosted in one process: each node's ports on a [`Hub`], its turn called by the runner
+//! in the clock chain's order, its warnings on the hub's `rosout`.
+
+use std::any::Any;
+use std::rc::Rc;
+
+use harvey_msgs::{LogLine, Message, topics};
+
+use super::memory::{Hub, OwnedFrame, Receiver, Sender};
+use super::{End, FrameView, Io, Node, Ports, Transport, msg_of, vec_of};
+use crate::resume::Marks;
+use crate::{Rosout, Sent};
+
+/// An input opened on a hub.
+pub(crate) trait MemInput {
+    fn topic(&self) -> &'static str;
+
+    fn take(&self, _out: &mut dyn Any) -> anyhow::Result<()> {
+        anyhow::bail!("{}: a frame input is read with `latest_frame`", self.topic())
+    }
+
+    fn latest_frame(&self) -> anyhow::Result<Option<Box<dyn FrameView>>> {
+        anyhow::bail!("{}: a message input is read with `take`", self.topic())
+    }
+}
+
+/// An output opened on a hub.
+pub(crate) trait MemOutput {
+    fn put(&self, msg: &dyn Any) -> anyhow::Result<()>;
+}
+
+impl<T: Message> MemInput for Receiver<T> {
+    fn topic(&self) -> &'static str {
+        Receiver::topic(self)
+    }
+
+    fn take(&self, out: &mut dyn Any) -> anyhow::Result<()> {
+        let out = vec_of::<T>(out, Receiver::topic(self))?;
+        out.clear();
+        self.drain(|m| out.push(m));
+        Ok(())
+    }
+}
+
+/// A frame input on a hub.
+pub(crate) struct FrameReceiver(pub Receiver<Rc<OwnedFrame>>);
+
+impl MemInput for FrameReceiver {
+    fn topic(&self) -> &'static str {
+        self.0.topic()
+    }
+
+    fn latest_frame(&self) -> anyhow::Result<Option<Box<dyn FrameView>>> {
+        Ok(self.0.latest().map(|f| Box::new(f) as Box<dyn FrameView>))
+    }
+}
+
+impl<T: Message> MemOutput for Sender<T> {
+    fn put(&self, msg: &dyn Any) -> anyhow::Result<()> {
+        self.send(*msg_of::<T>(msg, self.topic())?);
+        Ok(())
+    }
+}
+
+/// A node's ports on a hub.
+struct MemWired {
+    inputs: Vec<Box<dyn MemInput>>,
+    outputs: Vec<Box<dyn MemOutput>>,
+}
+
+impl Transport for MemWired {
+    fn take(&self, index: usize, out: &mut dyn Any) -> anyhow::Result<()> {
+        self.inputs[index].take(out)
+    }
+
+    fn latest_frame(&self, index: usize) -> anyhow::Result<Option<Box<dyn FrameView>>> {
+        self.inputs[index].latest_frame()
+    }
+
+    fn put(&self, index: usize, msg: &dyn Any) -> anyhow::Result<()> {
+        self.outputs[index].put(msg)
+    }
+}
+
+/// A node as the in-process runner holds it, whatever its state's type.
+pub trait Hosted {
+    /// The service's name (its `rosout` name).
+    fn name(&self) -> &str;
+    /// Before the first turn ([`Node::begin`], never resumed).
+    fn begin(&mut self) -> anyhow::Result<()>;
+    /// The node's turn on tick `tick`; its warnings go out on `rosout` stamped with it.
+    fn step(&mut self, tick: u64) -> anyhow::Result<()>;
+    /// Whether the node is done ([`Node::finished`]).
+    fn finished(&self) -> bool;
+    /// After the last turn; the exit code the node gives.
+    fn stop(&mut self, end: End) -> anyhow::Result<u8>;
+}
+
+struct InProcess<N: Node> {
+    name: String,
+    node: N,
+    state: N::State,
+    wired: MemWired,
+    taken: Marks,
+    sent: Sent,
+    newest: u64,
+    rosout: Rosout,
+    log: Sender<LogLine>,
+}
+
+impl<N: Node> InProcess<N> {
+    fn io(&mut self, tick: Option<u64>) -> (&mut N, &mut N::State, Io<'_>) {
+        let io = Io {
+            transport: &self.wired,
+            taken: &mut self.taken,
+            sent: &mut self.sent,
+            tick,
+            newest: &mut self.newest,
+        };
+        (&mut self.node, &mut self.state, io)
+    }
+}
+
+impl<N: Node> Hosted for InProcess<N> {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn begin(&mut self) -> anyhow::Result<()> {
+        let (node, state, mut io) = self.io(None);
+        node.begin(state, false, &mut io)
+    }
+
+    fn step(&mut self, tick: u64) -> anyhow::Result<()> {
+        self.rosout.begin();
+        let (node, state, mut io) = self.io(Some(tick));
+        node.step(state, &mut io)?;
+        let log = &self.log;
+        self.rosout.end_with(tick, |line| {
+            log.send(*line);
+            Ok(())
+        })?;
+        Ok(())
+    }
+
+    fn finished(&self) -> bool {
+        self.node.finished(&self.state)
+    }
+
+    fn stop(&mut self, end: End) -> anyhow::Result<u8> {
+        self.node.stopped(&self.state, end)
+    }
+}
+
+/// Hosts the node `build` makes as service `name`, its ports opened on `hub`.
+pub fn host<N: Node + 'static>(
+    name: &str,
+    hub: &Hub,
+    build: impl FnOnce(&mut Ports) -> anyhow::Result<N>,
+) -> anyhow::Result<Box<dyn Hosted>> {
+    let mut ports = Ports::default();
+    let mut node = build(&mut ports)?;
+    let wired = MemWired {
+        inputs: ports.inputs.iter().map(|i| i.open_memory(hub)).collect::<anyhow::Result<_>>()?,
+        outputs: ports.outputs.iter().map(|o| o.open_memory(hub)).collect::<anyhow::Result<_>>()?,
+    };
+    let state = node.start();
+    Ok(Box::new(InProcess {
+        name: name.to_owned(),
+        node,
+        state,
+        wired,
+        taken: Marks::default(),
+        sent: Sent::detached(),
+        newest: 0,
+        rosout: Rosout::detached(name),
+        log: hub.publisher(topics::ROSOUT.name, topics::ROSOUT.qos.buffer)?,
+    }))
+}

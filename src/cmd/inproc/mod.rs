@@ -1,0 +1,149 @@
+//! `harvey replay --in-process`: a recording's services run again as nodes of this one process,
+//! one thread, on a hub of in-memory topics; each tick the recorded inputs go out, then each
+//! clock party takes its turn in the chain's order (the recorder's turn writes the new
+//! recording), exactly as the multi-process replay hands the turns round over shared memory.
+
+mod registry;
+mod sink;
+
+use std::path::Path;
+use std::rc::Rc;
+use std::time::Instant;
+
+use clap::Parser;
+use harvey_msgs::{EncodersRaw, LogLine, SonarRaw, TruePose, topics};
+use harvey_recording::Recording;
+use harvey_recording::ticks::{Input, for_each_tick};
+use harvey_runtime::End;
+use harvey_runtime::node::Hosted;
+use harvey_runtime::node::memory::{Hub, OwnedFrame, Sender};
+use harvey_supervisor::LaunchFile;
+
+use sink::{RecorderArgs, Sink};
+
+/// The recorded inputs' publishers (the replayer's ports).
+struct Inputs {
+    truth: Sender<TruePose>,
+    sonar: Sender<SonarRaw>,
+    encoders: Sender<EncodersRaw>,
+    rosout: Sender<LogLine>,
+    frames: Sender<Rc<OwnedFrame>>,
+}
+
+impl Inputs {
+    fn open(hub: &Hub) -> anyhow::Result<Self> {
+        Ok(Self {
+            truth: hub.publisher(topics::SIM_TRUTH.name, topics::SIM_TRUTH.qos.buffer)?,
+            sonar: hub.publisher(topics::DRV_SONAR_RAW.name, topics::DRV_SONAR_RAW.qos.buffer)?,
+            encoders: hub.publisher(topics::DRV_ENCODERS_RAW.name, topics::DRV_ENCODERS_RAW.qos.buffer)?,
+            rosout: hub.publisher(topics::ROSOUT.name, topics::ROSOUT.qos.buffer)?,
+            frames: hub.publisher(topics::CAMERA_FRAME.name, topics::CAMERA_FRAME.qos.buffer)?,
+        })
+    }
+
+    fn send(&self, inputs: &[Input<'_>]) {
+        for input in inputs {
+            match input {
+                Input::Truth(m) => self.truth.send(*m),
+                Input::Sonar(m) => self.sonar.send(*m),
+                Input::Encoders(m) => self.encoders.send(*m),
+                Input::Log(m) => self.rosout.send(**m),
+                Input::Frame { header, pixels } => {
+                    self.frames.send(Rc::new(OwnedFrame { header: *header, pixels: pixels.to_vec() }))
+                }
+            }
+        }
+    }
+}
+
+/// A party of the clock chain, in process.
+enum Party {
+    Replayer,
+    Recorder,
+    Node(Box<dyn Hosted>),
+}
+
+/// What a replay in process did.
+pub struct Replayed {
+    pub ticks: u64,
+    pub messages: u64,
+    pub sim_s: f64,
+    pub wall_s: f64,
+    /// Wall time each clock party's turns took, in the chain's order (the replayer's: reading
+    /// nothing, handing the decoded inputs out; the recording is read between the turns).
+    pub turns: Vec<(String, f64)>,
+}
+
+/// Replays `recording` with the services of the replay launch file `launch_path` (as
+/// `replay_launch::prepare` writes it) in this process; the recorder's arguments say where
+/// the new recording goes.
+pub fn replay(recording: &Path, launch_path: &Path, run_dir: &Path) -> anyhow::Result<Replayed> {
+    let launch = LaunchFile::load(launch_path)?;
+    let vars = harvey_supervisor::variables(&launch, run_dir, "in-process")?;
+    let hub = Hub::default();
+    let inputs = Inputs::open(&hub)?;
+    let mut sink = None;
+    let mut nodes = Vec::new();
+    for s in &launch.services {
+        let (name, binary, args) = (s.name(), s.binary_name(), harvey_supervisor::expand_args(s, &vars));
+        match binary.as_str() {
+            "harvey-replayer" => {}
+            "harvey-recorder" => {
+                let argv = std::iter::once(binary.clone()).chain(args);
+                let a = RecorderArgs::try_parse_from(argv)
+                    .map_err(|e| anyhow::anyhow!("service {name}: its arguments: {e}"))?;
+                sink = Some((name.to_owned(), Sink::open(&a, &hub)?));
+            }
+            _ => nodes.push(registry::node(name, &binary, &args, &hub)?),
+        }
+    }
+    let (recorder, mut sink) =
+        sink.ok_or_else(|| anyhow::anyhow!("{}: no recorder", launch_path.display()))?;
+    for n in nodes.iter_mut() {
+        n.begin()?;
+    }
+    let mut chain = Vec::new();
+    for party in launch.clock_chain() {
+        chain.push(match party.as_str() {
+            "replayer" => Party::Replayer,
+            p if p == recorder => Party::Recorder,
+            p => {
+                let at = nodes.iter().position(|n| n.name() == p);
+                let at = at.ok_or_else(|| anyhow::anyhow!("clock party {p} is not a service"))?;
+                Party::Node(nodes.swap_remove(at))
+            }
+        });
+    }
+    anyhow::ensure!(nodes.is_empty(), "services off the clock chain cannot run in process");
+
+    let rec = Recording::open(recording)?;
+    let mut spent = vec![0.0; chain.len()];
+    let started = Instant::now();
+    let contents = for_each_tick::<anyhow::Error>(&rec, |tick, ins| {
+        for (party, spent) in chain.iter_mut().zip(spent.iter_mut()) {
+            let turn = Instant::now();
+            match party {
+                Party::Replayer => inputs.send(ins),
+                Party::Recorder => sink.record_tick(tick)?,
+                Party::Node(n) if !n.finished() => n.step(tick)?,
+                Party::Node(_) => {}
+            }
+            *spent += turn.elapsed().as_secs_f64();
+        }
+        Ok(())
+    })?;
+    let wall_s = started.elapsed().as_secs_f64();
+    let names = launch.clock_chain();
+    for party in chain.iter_mut() {
+        if let Party::Node(n) = party {
+            let end = if n.finished() { End::Finished } else { End::Stopped };
+            let code = n.stop(end)?;
+            anyhow::ensure!(code == 0 || end == End::Finished, "{} stopped with code {code}", n.name());
+        }
+    }
+    let messages = sink.messages;
+    sink.finish()?;
+    let sim_s = (contents.last_ns - contents.first_ns) as f64 / 1e9;
+    let turns = names.into_iter().zip(spent).collect();
+    Ok(Replayed { ticks: contents.ticks, messages, sim_s, wall_s, turns })
+}
