@@ -129,7 +129,7 @@ fn main() {
     };
     row("replay, ticks fed to the tail's last report (replayer's figure)", &|f| f.replay.clone());
     row("replay, whole command (start-up, check, shutdown included)", &|f| f.replay_wall.clone());
-    row("replay in process, first tick to the last turn (the replay's figure)", &|f| f.inproc.clone());
+    row("replay in process, first tick to the file finished (the replay's figure)", &|f| f.inproc.clone());
     row("replay in process, whole command (check included)", &|f| f.inproc_wall.clone());
     row("live deterministic run with rendering, whole command", &|f| f.live.clone());
     let met = |ok: bool| if ok { "met" } else { "NOT met" };

@@ -92,32 +92,15 @@ fn every_warning_a_service_printed_is_on_rosout_once_stamped_with_a_tick() {
         assert!(ticks.contains(&l.header.stamp_ns), "{} at {} ns is not a tick", l.name(), l.header.stamp_ns);
     }
 
-    // The replay publishes them again: the whole recording agrees, /rosout included.
+    // The replay publishes them again: the whole recording agrees, /rosout included; in one
+    // process too, the nodes' warnings captured and numbered the same way.
     let recording = run.dir.join("run.mcap");
-    let (out, prefix, _dir) = common::replay_check(&recording, "rosout-replay");
-    assert!(
-        out.status.success(),
-        "{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        common::agreed(&out).is_some_and(|n| n >= lines.len()),
-        "{}",
-        String::from_utf8_lossy(&out.stdout)
-    );
-    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
-    // In one process the nodes' warnings are captured and numbered the same way.
-    let (out, _, _) = common::replay_check_with(&recording, "rosout-inproc", &["--in-process"]);
-    assert!(
-        out.status.success(),
-        "{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    assert!(
-        common::agreed(&out).is_some_and(|n| n >= lines.len()),
-        "{}",
-        String::from_utf8_lossy(&out.stdout)
-    );
+    for (tag, how) in [("rosout-replay", &[][..]), ("rosout-inproc", &["--in-process"][..])] {
+        let (out, prefix, _dir) = common::replay_check_with(&recording, tag, how);
+        let said =
+            format!("{}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+        assert!(out.status.success(), "{tag}: {said}");
+        assert!(common::agreed(&out).is_some_and(|n| n >= lines.len()), "{tag}: {said}");
+        assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
+    }
 }

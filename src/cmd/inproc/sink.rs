@@ -104,13 +104,42 @@ impl TopicVisitor for Taps<'_> {
     }
 }
 
-/// The recording being written.
-pub struct Sink {
+/// One message on its way to the file: channel, topic, sequence, stamp and CDR bytes.
+type Item = (Channel, &'static str, u64, u64, Vec<u8>);
+
+/// The file, written on a thread of its own (as the recorder service does), so that compression
+/// and the derived topics overlap the next ticks' turns.
+struct Files {
     rec: Recorder,
-    taps: Vec<Box<dyn Tap>>,
     deriver: Deriver,
     derived: Vec<Channel>,
-    scratch: Vec<Derived>,
+}
+
+impl Files {
+    fn write(&mut self, items: Vec<Item>, scratch: &mut Vec<Derived>) -> anyhow::Result<()> {
+        for (ch, topic, seq, stamp, data) in items {
+            self.rec.record_encoded(ch, seq, stamp, &data)?;
+            self.deriver
+                .derive(topic, stamp, &data, scratch)
+                .map_err(|e| anyhow::anyhow!("deriving from {topic}: {e}"))?;
+            for d in scratch.drain(..) {
+                let ch = derive::index(d.topic).and_then(|k| self.derived.get(k).copied());
+                let ch = ch.ok_or_else(|| anyhow::anyhow!("no channel for the derived topic {}", d.topic))?;
+                self.rec.record_encoded(ch, d.seq, d.stamp_ns, &d.data)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Ticks the main thread may hand over before it waits for the writer.
+const QUEUE: usize = 16;
+
+/// The recording being written.
+pub struct Sink {
+    taps: Vec<Box<dyn Tap>>,
+    to_writer: std::sync::mpsc::SyncSender<Vec<Item>>,
+    writer: std::thread::JoinHandle<anyhow::Result<()>>,
     pub messages: u64,
     pub left_out: u64,
 }
@@ -150,11 +179,20 @@ impl Sink {
             hub.subscribe::<Rc<OwnedFrame>>(topics::CAMERA_FRAME.name, topics::CAMERA_FRAME.qos.buffer)?;
         taps.push(Box::new(FrameTap { rx, channel: frame_channel }));
         let derived = rec.derived_channels()?;
-        let deriver = Deriver::new(world.as_ref());
-        Ok(Self { rec, taps, deriver, derived, scratch: Vec::new(), messages: 0, left_out: 0 })
+        let mut files = Files { rec, deriver: Deriver::new(world.as_ref()), derived };
+        let (to_writer, ticks) = std::sync::mpsc::sync_channel::<Vec<Item>>(QUEUE);
+        let writer = std::thread::Builder::new().name("mcap-writer".into()).spawn(move || {
+            let mut scratch = Vec::new();
+            for items in ticks {
+                files.write(items, &mut scratch)?;
+            }
+            files.rec.finish()?;
+            Ok(())
+        })?;
+        Ok(Self { taps, to_writer, writer, messages: 0, left_out: 0 })
     }
 
-    /// The recorder's turn on tick `tick`: what every topic holds, written in tap order.
+    /// The recorder's turn on tick `tick`: what every topic holds, in tap order, to the writer.
     pub fn record_tick(&mut self, tick: u64) -> anyhow::Result<()> {
         let mut items = Vec::new();
         for t in &self.taps {
@@ -162,24 +200,15 @@ impl Sink {
                 .take(tick, &mut |ch, topic, seq, stamp, data| items.push((ch, topic, seq, stamp, data)))
                 as u64;
         }
-        for (ch, topic, seq, stamp, data) in items {
-            self.rec.record_encoded(ch, seq, stamp, &data)?;
-            self.messages += 1;
-            self.deriver
-                .derive(topic, stamp, &data, &mut self.scratch)
-                .map_err(|e| anyhow::anyhow!("deriving from {topic}: {e}"))?;
-            for d in self.scratch.drain(..) {
-                let ch = derive::index(d.topic).and_then(|k| self.derived.get(k).copied());
-                let ch = ch.ok_or_else(|| anyhow::anyhow!("no channel for the derived topic {}", d.topic))?;
-                self.rec.record_encoded(ch, d.seq, d.stamp_ns, &d.data)?;
-            }
-        }
+        self.messages += items.len() as u64;
+        // A send fails only once the writer has stopped on an error, which `finish` reports.
+        let _ = self.to_writer.send(items);
         Ok(())
     }
 
-    /// Finishes the file.
+    /// Writes what is queued and finishes the file.
     pub fn finish(self) -> anyhow::Result<()> {
-        self.rec.finish()?;
-        Ok(())
+        drop(self.to_writer);
+        self.writer.join().map_err(|_| anyhow::anyhow!("the MCAP writer thread panicked"))?
     }
 }

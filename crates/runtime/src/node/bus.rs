@@ -7,81 +7,42 @@ use std::process::ExitCode;
 use harvey_bus::{Bus, FrameSubscriber, Pace, Publisher, Step, Subscriber, Waitable, Waiter};
 use harvey_msgs::Message;
 
-use super::{End, FrameView, Io, Node, Ports, Transport, msg_of, vec_of};
+use super::{End, FrameView, InputPort, Io, Node, OutputPort, Ports, Wired, msg_of, vec_of};
 use crate::{Resume, Rosout, Sent};
 
-/// An input opened on the bus.
-pub(crate) trait BusInput {
-    fn topic(&self) -> &'static str;
-    fn waitable(&self) -> &dyn Waitable;
-
-    fn take(&self, _out: &mut dyn Any) -> anyhow::Result<()> {
-        anyhow::bail!("{}: a frame input is read with `latest_frame`", self.topic())
-    }
-
-    fn latest_frame(&self) -> anyhow::Result<Option<Box<dyn FrameView>>> {
-        anyhow::bail!("{}: a message input is read with `take`", self.topic())
-    }
-}
-
-/// An output opened on the bus.
-pub(crate) trait BusOutput {
-    fn put(&self, msg: &dyn Any) -> anyhow::Result<()>;
-}
-
-impl<T: Message> BusInput for Subscriber<T> {
+impl<T: Message> InputPort for Subscriber<T> {
     fn topic(&self) -> &'static str {
         Subscriber::topic(self)
-    }
-
-    fn waitable(&self) -> &dyn Waitable {
-        self
     }
 
     fn take(&self, out: &mut dyn Any) -> anyhow::Result<()> {
         self.drain_into(vec_of::<T>(out, Subscriber::topic(self))?)?;
         Ok(())
     }
+
+    fn waitable(&self) -> Option<&dyn Waitable> {
+        Some(self)
+    }
 }
 
-impl BusInput for FrameSubscriber {
+impl InputPort for FrameSubscriber {
     fn topic(&self) -> &'static str {
         FrameSubscriber::topic(self)
-    }
-
-    fn waitable(&self) -> &dyn Waitable {
-        self
     }
 
     fn latest_frame(&self) -> anyhow::Result<Option<Box<dyn FrameView>>> {
         Ok(self.latest()?.map(|f| Box::new(f) as Box<dyn FrameView>))
     }
+
+    fn waitable(&self) -> Option<&dyn Waitable> {
+        Some(self)
+    }
 }
 
-impl<T: Message> BusOutput for Publisher<T> {
+impl<T: Message> OutputPort for Publisher<T> {
     fn put(&self, msg: &dyn Any) -> anyhow::Result<()> {
         self.send(msg_of::<T>(msg, self.topic())?)?;
         Ok(())
-    }
-}
-
-/// A node's ports on the bus.
-struct Wired {
-    inputs: Vec<Box<dyn BusInput>>,
-    outputs: Vec<Box<dyn BusOutput>>,
-}
-
-impl Transport for Wired {
-    fn take(&self, index: usize, out: &mut dyn Any) -> anyhow::Result<()> {
-        self.inputs[index].take(out)
-    }
-
-    fn latest_frame(&self, index: usize) -> anyhow::Result<Option<Box<dyn FrameView>>> {
-        self.inputs[index].latest_frame()
-    }
-
-    fn put(&self, index: usize, msg: &dyn Any) -> anyhow::Result<()> {
-        self.outputs[index].put(msg)
     }
 }
 
@@ -104,7 +65,7 @@ pub fn run<N: Node>(
     let mut rosout = Rosout::new(&bus, name)?;
     let pace = Pace::from_env(&bus)?;
     let waiter = Waiter::new()?;
-    let wakes: Vec<&dyn Waitable> = wired.inputs.iter().map(|i| i.waitable()).collect();
+    let wakes: Vec<&dyn Waitable> = wired.inputs.iter().filter_map(|i| i.waitable()).collect();
     let attachments = pace.attach(&waiter, &wakes)?;
     let checkpoint = match N::CHECKPOINT_BYTES {
         0 => None,
@@ -117,7 +78,7 @@ pub fn run<N: Node>(
     let mut newest = 0;
     let resumed = resume.resumed();
     let (state, taken) = resume.parts();
-    let mut io = Io { transport: &wired, taken, sent: &mut sent, tick: None, newest: &mut newest };
+    let mut io = Io { ports: &wired, taken, sent: &mut sent, tick: None, newest: &mut newest };
     node.begin(state, resumed, &mut io)?;
     let end = loop {
         if node.finished(resume.parts().0) {
@@ -130,7 +91,7 @@ pub fn run<N: Node>(
         };
         rosout.begin();
         let (state, taken) = resume.parts();
-        let mut io = Io { transport: &wired, taken, sent: &mut sent, tick, newest: &mut newest };
+        let mut io = Io { ports: &wired, taken, sent: &mut sent, tick, newest: &mut newest };
         node.step(state, &mut io)?;
         let now = io.now();
         rosout.end(now)?;

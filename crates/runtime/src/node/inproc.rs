@@ -7,29 +7,11 @@ use std::rc::Rc;
 use harvey_msgs::{LogLine, Message, topics};
 
 use super::memory::{Hub, OwnedFrame, Receiver, Sender};
-use super::{End, FrameView, Io, Node, Ports, Transport, msg_of, vec_of};
+use super::{End, FrameView, InputPort, Io, Node, OutputPort, Ports, Wired, msg_of, vec_of};
 use crate::resume::Marks;
 use crate::{Rosout, Sent};
 
-/// An input opened on a hub.
-pub(crate) trait MemInput {
-    fn topic(&self) -> &'static str;
-
-    fn take(&self, _out: &mut dyn Any) -> anyhow::Result<()> {
-        anyhow::bail!("{}: a frame input is read with `latest_frame`", self.topic())
-    }
-
-    fn latest_frame(&self) -> anyhow::Result<Option<Box<dyn FrameView>>> {
-        anyhow::bail!("{}: a message input is read with `take`", self.topic())
-    }
-}
-
-/// An output opened on a hub.
-pub(crate) trait MemOutput {
-    fn put(&self, msg: &dyn Any) -> anyhow::Result<()>;
-}
-
-impl<T: Message> MemInput for Receiver<T> {
+impl<T: Message> InputPort for Receiver<T> {
     fn topic(&self) -> &'static str {
         Receiver::topic(self)
     }
@@ -45,7 +27,7 @@ impl<T: Message> MemInput for Receiver<T> {
 /// A frame input on a hub.
 pub(crate) struct FrameReceiver(pub Receiver<Rc<OwnedFrame>>);
 
-impl MemInput for FrameReceiver {
+impl InputPort for FrameReceiver {
     fn topic(&self) -> &'static str {
         self.0.topic()
     }
@@ -55,30 +37,10 @@ impl MemInput for FrameReceiver {
     }
 }
 
-impl<T: Message> MemOutput for Sender<T> {
+impl<T: Message> OutputPort for Sender<T> {
     fn put(&self, msg: &dyn Any) -> anyhow::Result<()> {
         self.send(*msg_of::<T>(msg, self.topic())?);
         Ok(())
-    }
-}
-
-/// A node's ports on a hub.
-struct MemWired {
-    inputs: Vec<Box<dyn MemInput>>,
-    outputs: Vec<Box<dyn MemOutput>>,
-}
-
-impl Transport for MemWired {
-    fn take(&self, index: usize, out: &mut dyn Any) -> anyhow::Result<()> {
-        self.inputs[index].take(out)
-    }
-
-    fn latest_frame(&self, index: usize) -> anyhow::Result<Option<Box<dyn FrameView>>> {
-        self.inputs[index].latest_frame()
-    }
-
-    fn put(&self, index: usize, msg: &dyn Any) -> anyhow::Result<()> {
-        self.outputs[index].put(msg)
     }
 }
 
@@ -100,7 +62,7 @@ struct InProcess<N: Node> {
     name: String,
     node: N,
     state: N::State,
-    wired: MemWired,
+    wired: Wired,
     taken: Marks,
     sent: Sent,
     newest: u64,
@@ -111,7 +73,7 @@ struct InProcess<N: Node> {
 impl<N: Node> InProcess<N> {
     fn io(&mut self, tick: Option<u64>) -> (&mut N, &mut N::State, Io<'_>) {
         let io = Io {
-            transport: &self.wired,
+            ports: &self.wired,
             taken: &mut self.taken,
             sent: &mut self.sent,
             tick,
@@ -160,7 +122,7 @@ pub fn host<N: Node + 'static>(
 ) -> anyhow::Result<Box<dyn Hosted>> {
     let mut ports = Ports::default();
     let mut node = build(&mut ports)?;
-    let wired = MemWired {
+    let wired = Wired {
         inputs: ports.inputs.iter().map(|i| i.open_memory(hub)).collect::<anyhow::Result<_>>()?,
         outputs: ports.outputs.iter().map(|o| o.open_memory(hub)).collect::<anyhow::Result<_>>()?,
     };

@@ -3,7 +3,7 @@
 
 use harvey_msgs::{FrameHeader, Message};
 
-use super::{FrameIn, In, Out, Transport};
+use super::{FrameIn, In, Out, Wired};
 use crate::Sent;
 use crate::resume::Marks;
 
@@ -25,7 +25,7 @@ impl FrameView for harvey_bus::Frame {
 
 /// A node's ports during one turn (or [`super::Node::begin`]).
 pub struct Io<'a> {
-    pub(crate) transport: &'a dyn Transport,
+    pub(crate) ports: &'a Wired,
     pub(crate) taken: &'a mut Marks,
     pub(crate) sent: &'a mut Sent,
     pub(crate) tick: Option<u64>,
@@ -36,7 +36,7 @@ impl Io<'_> {
     /// Replaces `out` with the messages that came in on `input` since the last turn, oldest first,
     /// less those a predecessor of this process had taken already. Reuse `out` across turns.
     pub fn take<T: Message>(&mut self, input: In<T>, out: &mut Vec<T>) -> anyhow::Result<()> {
-        self.transport.take(input.index, out)?;
+        self.ports.inputs[input.index].take(out)?;
         let taken = &mut *self.taken;
         out.retain(|m| taken.fresh(input.topic, m.header().stamp_ns, m.header().seq));
         *self.newest = out.iter().map(|m| m.header().stamp_ns).fold(*self.newest, u64::max);
@@ -46,7 +46,7 @@ impl Io<'_> {
     /// The newest frame that came in on `input` (older ones are dropped: a late worker skips,
     /// it does not fall further behind), unless a predecessor of this process had taken it.
     pub fn latest_frame(&mut self, input: FrameIn) -> anyhow::Result<Option<Box<dyn FrameView>>> {
-        let frame = self.transport.latest_frame(input.index)?;
+        let frame = self.ports.inputs[input.index].latest_frame()?;
         let frame = frame.filter(|f| self.taken.fresh(input.topic, f.header().stamp_ns, f.header().seq));
         if let Some(f) = &frame {
             *self.newest = (*self.newest).max(f.header().stamp_ns);
@@ -70,7 +70,7 @@ impl Io<'_> {
     pub fn send_as<T: Message>(&mut self, output: Out<T>, key: &str, msg: &T) -> anyhow::Result<()> {
         let h = *msg.header();
         if self.sent.due(key, h.stamp_ns, h.seq) {
-            self.transport.put(output.index, msg)?;
+            self.ports.outputs[output.index].put(msg)?;
             self.sent.done(key, h.stamp_ns, h.seq)?;
         }
         Ok(())

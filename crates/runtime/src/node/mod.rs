@@ -77,14 +77,37 @@ pub trait Node {
     }
 }
 
-/// Moves messages between a node and its ports; the runner's transport behind [`Io`].
-pub(crate) trait Transport {
-    /// Replaces `out` (a `Vec<T>` of input `index`'s type) with what came in, oldest first.
-    fn take(&self, index: usize, out: &mut dyn Any) -> anyhow::Result<()>;
-    /// The newest frame of frame input `index`, older ones released.
-    fn latest_frame(&self, index: usize) -> anyhow::Result<Option<Box<dyn FrameView>>>;
-    /// Sends `msg` (a `T` of output `index`'s type).
-    fn put(&self, index: usize, msg: &dyn Any) -> anyhow::Result<()>;
+/// An input port as a runner opened it (a bus subscriber, a hub queue).
+pub(crate) trait InputPort {
+    fn topic(&self) -> &'static str;
+
+    /// Replaces `out` (a `Vec<T>` of the port's type) with what came in, oldest first.
+    fn take(&self, _out: &mut dyn Any) -> anyhow::Result<()> {
+        anyhow::bail!("{}: a frame input is read with `latest_frame`", self.topic())
+    }
+
+    /// The newest frame, older ones released.
+    fn latest_frame(&self) -> anyhow::Result<Option<Box<dyn FrameView>>> {
+        anyhow::bail!("{}: a message input is read with `take`", self.topic())
+    }
+
+    /// What wakes a process runner when the port has news (none in process).
+    fn waitable(&self) -> Option<&dyn harvey_bus::Waitable> {
+        None
+    }
+}
+
+/// An output port as a runner opened it.
+pub(crate) trait OutputPort {
+    /// Sends `msg` (a `T` of the port's type).
+    fn put(&self, msg: &dyn Any) -> anyhow::Result<()>;
+}
+
+/// A node's ports as a runner opened them, in the order [`Ports`] declared them: what [`Io`]
+/// moves messages through.
+pub(crate) struct Wired {
+    pub inputs: Vec<Box<dyn InputPort>>,
+    pub outputs: Vec<Box<dyn OutputPort>>,
 }
 
 /// `out` as the `Vec<T>` a port of type `T` fills, or an error naming the topic.

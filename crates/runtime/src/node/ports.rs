@@ -6,9 +6,9 @@ use harvey_bus::Bus;
 use harvey_msgs::Message;
 use harvey_msgs::topics::{FrameTopic, Topic};
 
-use super::bus::{BusInput, BusOutput};
-use super::inproc::{FrameReceiver, MemInput, MemOutput};
+use super::inproc::FrameReceiver;
 use super::memory::Hub;
+use super::{InputPort, OutputPort};
 
 /// An input of a node: messages of type `T` from one topic.
 pub struct In<T> {
@@ -59,15 +59,15 @@ impl<T> Out<T> {
 /// An input as a runner opens it.
 pub(crate) trait InputSpec {
     fn topic(&self) -> &'static str;
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>>;
-    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemInput>>;
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn InputPort>>;
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn InputPort>>;
 }
 
 /// An output as a runner opens it.
 pub(crate) trait OutputSpec {
     fn topic(&self) -> &'static str;
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusOutput>>;
-    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemOutput>>;
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn OutputPort>>;
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn OutputPort>>;
 }
 
 impl<T: Message> InputSpec for Topic<T> {
@@ -75,11 +75,11 @@ impl<T: Message> InputSpec for Topic<T> {
         self.name
     }
 
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>> {
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn InputPort>> {
         Ok(Box::new(bus.subscriber::<T>(*self)?))
     }
 
-    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemInput>> {
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn InputPort>> {
         Ok(Box::new(hub.subscribe::<T>(self.name, self.qos.buffer)?))
     }
 }
@@ -89,11 +89,11 @@ impl InputSpec for FrameTopic {
         self.name
     }
 
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusInput>> {
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn InputPort>> {
         Ok(Box::new(bus.frame_subscriber(*self)?))
     }
 
-    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemInput>> {
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn InputPort>> {
         Ok(Box::new(FrameReceiver(hub.subscribe(self.name, self.qos.buffer)?)))
     }
 }
@@ -103,11 +103,11 @@ impl<T: Message> OutputSpec for Topic<T> {
         self.name
     }
 
-    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn BusOutput>> {
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn OutputPort>> {
         Ok(Box::new(bus.publisher::<T>(*self)?))
     }
 
-    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn MemOutput>> {
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn OutputPort>> {
         Ok(Box::new(hub.publisher::<T>(self.name, self.qos.buffer)?))
     }
 }
