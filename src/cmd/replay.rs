@@ -52,6 +52,9 @@ pub fn run(recording: &Path, how: How, opts: LaunchArgs) -> anyhow::Result<i32> 
         );
         let turns: Vec<String> = r.turns.iter().map(|(p, s)| format!("{p} {:.1} ms", s * 1e3)).collect();
         println!("turns: {}", turns.join(", "));
+        if r.left_out > 0 {
+            println!("left out: {} messages stamped after the tick they came in", r.left_out);
+        }
     } else {
         println!("replaying: {} (the launch {} carries)", file.display(), recording.display());
         let (outcome, _) = launch_file(&file, &LaunchArgs { run_dir: Some(run_dir.clone()), ..opts })?;

@@ -15,7 +15,7 @@ pub mod throttle;
 
 pub use checkpoint::{Checkpoint, CheckpointError, STATE_DIR_ENV};
 pub use journal::Journal;
-pub use node::{End, FrameIn, FrameView, In, Io, Node, Out, Ports};
+pub use node::{End, FrameIn, FrameOut, FrameView, In, Io, Node, Out, Ports};
 pub use resume::{Marks, Resume, Sent};
 pub use rosout::Rosout;
 pub use throttle::{Say, Throttle};

@@ -145,6 +145,9 @@ impl Node for ExecutiveNode {
     fn start(&mut self) {}
 
     fn begin(&mut self, _: &mut (), _: bool, io: &mut Io<'_>) -> anyhow::Result<()> {
+        if !io.persistent() {
+            return Ok(());
+        }
         let Some((journal, past)) = Journal::from_env::<Journaled>("executive")? else {
             return Ok(());
         };

@@ -10,6 +10,7 @@ use std::path::Path;
 use std::rc::Rc;
 use std::time::Instant;
 
+use anyhow::Context;
 use clap::Parser;
 use harvey_msgs::{EncodersRaw, LogLine, SonarRaw, TruePose, topics};
 use harvey_recording::Recording;
@@ -41,7 +42,7 @@ impl Inputs {
         })
     }
 
-    fn send(&self, inputs: &[Input<'_>]) {
+    fn send(&self, inputs: &[Input<'_>]) -> anyhow::Result<()> {
         for input in inputs {
             match input {
                 Input::Truth(m) => self.truth.send(*m),
@@ -49,10 +50,20 @@ impl Inputs {
                 Input::Encoders(m) => self.encoders.send(*m),
                 Input::Log(m) => self.rosout.send(**m),
                 Input::Frame { header, pixels } => {
+                    anyhow::ensure!(
+                        pixels.len() == header.payload_len(),
+                        "frame {} at {} ns: {} bytes of pixels for a {}x{} image",
+                        header.seq,
+                        header.stamp_ns,
+                        pixels.len(),
+                        header.width_px,
+                        header.height_px
+                    );
                     self.frames.send(Rc::new(OwnedFrame { header: *header, pixels: pixels.to_vec() }))
                 }
             }
         }
+        Ok(())
     }
 }
 
@@ -69,6 +80,9 @@ pub struct Replayed {
     pub messages: u64,
     pub sim_s: f64,
     pub wall_s: f64,
+    /// Messages stamped after the tick their recorder's turn took them in, left out (as the
+    /// recorder leaves them out).
+    pub left_out: u64,
     /// Wall time each clock party's turns took, in the chain's order (the replayer's: reading
     /// nothing, handing the decoded inputs out; the recording is read between the turns).
     pub turns: Vec<(String, f64)>,
@@ -99,9 +113,6 @@ pub fn replay(recording: &Path, launch_path: &Path, run_dir: &Path) -> anyhow::R
     }
     let (recorder, mut sink) =
         sink.ok_or_else(|| anyhow::anyhow!("{}: no recorder", launch_path.display()))?;
-    for n in nodes.iter_mut() {
-        n.begin()?;
-    }
     let mut chain = Vec::new();
     for party in launch.clock_chain() {
         chain.push(match party.as_str() {
@@ -114,37 +125,53 @@ pub fn replay(recording: &Path, launch_path: &Path, run_dir: &Path) -> anyhow::R
             }
         });
     }
-    anyhow::ensure!(nodes.is_empty(), "services off the clock chain cannot run in process");
-
+    let off: Vec<&str> = nodes.iter().map(|n| n.name()).collect();
+    anyhow::ensure!(off.is_empty(), "services off the clock chain cannot run in process: {}", off.join(", "));
+    // As the replayer does: the whole recording is checked before any service sees it.
     let rec = Recording::open(recording)?;
+    let contents = for_each_tick::<anyhow::Error>(&rec, |_, _| Ok(()))?;
+    anyhow::ensure!(contents.ticks > 0, "{}: holds no inputs to replay", recording.display());
+    for party in chain.iter_mut() {
+        if let Party::Node(n) = party {
+            n.begin().with_context(|| format!("service {}, starting", n.name()))?;
+        }
+    }
+
     let mut spent = vec![0.0; chain.len()];
     let started = Instant::now();
-    let contents = for_each_tick::<anyhow::Error>(&rec, |tick, ins| {
+    let ran = for_each_tick::<anyhow::Error>(&rec, |tick, ins| {
         for (party, spent) in chain.iter_mut().zip(spent.iter_mut()) {
             let turn = Instant::now();
             match party {
-                Party::Replayer => inputs.send(ins),
+                Party::Replayer => inputs.send(ins)?,
                 Party::Recorder => sink.record_tick(tick)?,
-                Party::Node(n) if !n.finished() => n.step(tick)?,
+                Party::Node(n) if !n.finished() => {
+                    let name = n.name().to_owned();
+                    n.step(tick).with_context(|| format!("service {name}, tick at {tick} ns"))?
+                }
                 Party::Node(_) => {}
             }
             *spent += turn.elapsed().as_secs_f64();
         }
         Ok(())
-    })?;
+    });
+    if let Err(e) = ran {
+        // The writer's own error, if it stopped first, says more than a closed channel.
+        return Err(sink.finish().err().unwrap_or(e).context(recording.display().to_string()));
+    }
     let names = launch.clock_chain();
     for party in chain.iter_mut() {
         if let Party::Node(n) = party {
             let end = if n.finished() { End::Finished } else { End::Stopped };
-            let code = n.stop(end)?;
+            let code = n.stop(end).with_context(|| format!("service {}, stopping", n.name()))?;
             anyhow::ensure!(code == 0 || end == End::Finished, "{} stopped with code {code}", n.name());
         }
     }
-    let messages = sink.messages;
+    let (messages, left_out) = (sink.messages, sink.left_out);
     sink.finish()?;
     // The file finished is part of the replay's time (its writer runs beside the turns).
     let wall_s = started.elapsed().as_secs_f64();
     let sim_s = (contents.last_ns - contents.first_ns) as f64 / 1e9;
     let turns = names.into_iter().zip(spent).collect();
-    Ok(Replayed { ticks: contents.ticks, messages, sim_s, wall_s, turns })
+    Ok(Replayed { ticks: contents.ticks, messages, sim_s, wall_s, left_out, turns })
 }

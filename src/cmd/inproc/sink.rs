@@ -11,12 +11,12 @@ use harvey_cdr::{Ros2Msg, encode, encode_image};
 use harvey_msgs::{Message, Topic, topics};
 use harvey_recording::derive::{self, Derived, Deriver};
 use harvey_recording::topics::{TopicVisitor, visit_message_topics};
-use harvey_recording::{Channel, Recorder, data_files};
+use harvey_recording::{Channel, ChunkCompression, Recorder, data_files};
 use harvey_runtime::node::memory::{Hub, OwnedFrame, Receiver};
 
 /// The recorder service's arguments, as its launch line gives them (`harvey-recorder`'s own;
-/// the in-process recorder writes the MCAP file only, so `--rrd`, `--live`, `--flush-ms` and
-/// `--compression` are accepted and not used).
+/// the in-process recorder writes the MCAP file only, so `--rrd`, `--live` and `--flush-ms` are
+/// accepted and not used).
 #[derive(Parser)]
 #[command(name = "harvey-recorder")]
 pub struct RecorderArgs {
@@ -34,8 +34,19 @@ pub struct RecorderArgs {
     seed: u64,
     #[arg(long)]
     launch: Option<PathBuf>,
-    #[arg(long)]
-    compression: Option<String>,
+    #[arg(long, default_value = "zstd")]
+    compression: String,
+}
+
+/// The chunk compression the recorder's `--compression` names.
+fn compression(name: &str) -> anyhow::Result<ChunkCompression> {
+    Ok(match name {
+        "zstd" => ChunkCompression::Zstd,
+        "zstd-fast" => ChunkCompression::ZstdFast,
+        "lz4" => ChunkCompression::Lz4,
+        "none" => ChunkCompression::None,
+        other => anyhow::bail!("--compression `{other}`: expected zstd, zstd-fast, lz4 or none"),
+    })
 }
 
 /// A recorded topic's subscription on the hub.
@@ -148,7 +159,7 @@ impl Sink {
     /// The recording the recorder's arguments describe, its world and launch attached, every
     /// topic subscribed on `hub`.
     pub fn open(args: &RecorderArgs, hub: &Hub) -> anyhow::Result<Self> {
-        let mut rec = Recorder::create(&args.output)?;
+        let mut rec = Recorder::create_with(&args.output, compression(&args.compression)?)?;
         let mut world = None;
         if let Some(path) = &args.world {
             let text =
@@ -202,8 +213,7 @@ impl Sink {
         }
         self.messages += items.len() as u64;
         // A send fails only once the writer has stopped on an error, which `finish` reports.
-        let _ = self.to_writer.send(items);
-        Ok(())
+        self.to_writer.send(items).map_err(|_| anyhow::anyhow!("the MCAP writer stopped"))
     }
 
     /// Writes what is queued and finishes the file.

@@ -4,8 +4,8 @@
 use std::any::Any;
 use std::process::ExitCode;
 
-use harvey_bus::{Bus, FrameSubscriber, Pace, Publisher, Step, Subscriber, Waitable, Waiter};
-use harvey_msgs::Message;
+use harvey_bus::{Bus, FramePublisher, FrameSubscriber, Pace, Publisher, Step, Subscriber, Waitable, Waiter};
+use harvey_msgs::{FrameHeader, Message};
 
 use super::{End, FrameView, InputPort, Io, Node, OutputPort, Ports, Wired, msg_of, vec_of};
 use crate::{Resume, Rosout, Sent};
@@ -40,8 +40,29 @@ impl InputPort for FrameSubscriber {
 }
 
 impl<T: Message> OutputPort for Publisher<T> {
+    fn topic(&self) -> &'static str {
+        Publisher::topic(self)
+    }
+
     fn put(&self, msg: &dyn Any) -> anyhow::Result<()> {
         self.send(msg_of::<T>(msg, self.topic())?)?;
+        Ok(())
+    }
+}
+
+impl OutputPort for FramePublisher {
+    fn topic(&self) -> &'static str {
+        FramePublisher::topic(self)
+    }
+
+    fn put_frame(
+        &self,
+        header: FrameHeader,
+        fill: &mut dyn FnMut(&mut [u8]) -> anyhow::Result<()>,
+    ) -> anyhow::Result<()> {
+        let mut frame = self.loan(header)?;
+        fill(frame.pixels_mut())?;
+        frame.send()?;
         Ok(())
     }
 }
@@ -67,6 +88,11 @@ pub fn run<N: Node>(
     let waiter = Waiter::new()?;
     let wakes: Vec<&dyn Waitable> = wired.inputs.iter().filter_map(|i| i.waitable()).collect();
     let attachments = pace.attach(&waiter, &wakes)?;
+    // A source's own rate, in real time only: a clock party's turns come from the chain.
+    let interval = match ports.interval.filter(|_| pace.lockstep().is_none()) {
+        Some(period) => Some(waiter.attach_interval(period)?),
+        None => None,
+    };
     let checkpoint = match N::CHECKPOINT_BYTES {
         0 => None,
         bytes => crate::Checkpoint::from_env(name, bytes)?,
@@ -76,9 +102,10 @@ pub fn run<N: Node>(
     crate::notify_ready()?;
 
     let mut newest = 0;
+    let persistent = std::env::var_os(crate::STATE_DIR_ENV).is_some();
     let resumed = resume.resumed();
     let (state, taken) = resume.parts();
-    let mut io = Io { ports: &wired, taken, sent: &mut sent, tick: None, newest: &mut newest };
+    let mut io = Io { ports: &wired, taken, sent: &mut sent, tick: None, newest: &mut newest, persistent };
     node.begin(state, resumed, &mut io)?;
     let end = loop {
         if node.finished(resume.parts().0) {
@@ -91,7 +118,7 @@ pub fn run<N: Node>(
         };
         rosout.begin();
         let (state, taken) = resume.parts();
-        let mut io = Io { ports: &wired, taken, sent: &mut sent, tick, newest: &mut newest };
+        let mut io = Io { ports: &wired, taken, sent: &mut sent, tick, newest: &mut newest, persistent };
         node.step(state, &mut io)?;
         let now = io.now();
         rosout.end(now)?;
@@ -101,6 +128,6 @@ pub fn run<N: Node>(
         resume.tick_done()?;
         pace.done()?;
     };
-    drop(attachments);
+    drop((attachments, interval));
     Ok(ExitCode::from(node.stopped(resume.parts().0, end)?))
 }

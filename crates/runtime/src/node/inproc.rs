@@ -4,7 +4,7 @@
 use std::any::Any;
 use std::rc::Rc;
 
-use harvey_msgs::{LogLine, Message, topics};
+use harvey_msgs::{FrameHeader, LogLine, Message, topics};
 
 use super::memory::{Hub, OwnedFrame, Receiver, Sender};
 use super::{End, FrameView, InputPort, Io, Node, OutputPort, Ports, Wired, msg_of, vec_of};
@@ -38,8 +38,42 @@ impl InputPort for FrameReceiver {
 }
 
 impl<T: Message> OutputPort for Sender<T> {
+    fn topic(&self) -> &'static str {
+        Sender::topic(self)
+    }
+
     fn put(&self, msg: &dyn Any) -> anyhow::Result<()> {
         self.send(*msg_of::<T>(msg, self.topic())?);
+        Ok(())
+    }
+}
+
+/// A frame output on a hub: each frame a buffer of its own, shared by the subscribers.
+pub(crate) struct FrameSender {
+    pub tx: Sender<Rc<OwnedFrame>>,
+    pub max_frame_bytes: usize,
+}
+
+impl OutputPort for FrameSender {
+    fn topic(&self) -> &'static str {
+        self.tx.topic()
+    }
+
+    fn put_frame(
+        &self,
+        header: FrameHeader,
+        fill: &mut dyn FnMut(&mut [u8]) -> anyhow::Result<()>,
+    ) -> anyhow::Result<()> {
+        let len = header.payload_len();
+        anyhow::ensure!(
+            len > 0 && len <= self.max_frame_bytes,
+            "{}: frame size out of range: {len} bytes, publisher sized for 1..={}",
+            self.tx.topic(),
+            self.max_frame_bytes
+        );
+        let mut pixels = vec![0; len];
+        fill(&mut pixels)?;
+        self.tx.send(Rc::new(OwnedFrame { header, pixels }));
         Ok(())
     }
 }
@@ -78,6 +112,7 @@ impl<N: Node> InProcess<N> {
             sent: &mut self.sent,
             tick,
             newest: &mut self.newest,
+            persistent: false,
         };
         (&mut self.node, &mut self.state, io)
     }

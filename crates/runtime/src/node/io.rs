@@ -3,7 +3,7 @@
 
 use harvey_msgs::{FrameHeader, Message};
 
-use super::{FrameIn, In, Out, Wired};
+use super::{FrameIn, FrameOut, In, Out, Wired};
 use crate::Sent;
 use crate::resume::Marks;
 
@@ -30,13 +30,15 @@ pub struct Io<'a> {
     pub(crate) sent: &'a mut Sent,
     pub(crate) tick: Option<u64>,
     pub(crate) newest: &'a mut u64,
+    /// Whether what the node keeps outlives this process (a supervised process's state folder).
+    pub(crate) persistent: bool,
 }
 
 impl Io<'_> {
     /// Replaces `out` with the messages that came in on `input` since the last turn, oldest first,
     /// less those a predecessor of this process had taken already. Reuse `out` across turns.
     pub fn take<T: Message>(&mut self, input: In<T>, out: &mut Vec<T>) -> anyhow::Result<()> {
-        self.ports.inputs[input.index].take(out)?;
+        self.ports.input(input.index, input.topic)?.take(out)?;
         let taken = &mut *self.taken;
         out.retain(|m| taken.fresh(input.topic, m.header().stamp_ns, m.header().seq));
         *self.newest = out.iter().map(|m| m.header().stamp_ns).fold(*self.newest, u64::max);
@@ -46,7 +48,7 @@ impl Io<'_> {
     /// The newest frame that came in on `input` (older ones are dropped: a late worker skips,
     /// it does not fall further behind), unless a predecessor of this process had taken it.
     pub fn latest_frame(&mut self, input: FrameIn) -> anyhow::Result<Option<Box<dyn FrameView>>> {
-        let frame = self.ports.inputs[input.index].latest_frame()?;
+        let frame = self.ports.input(input.index, input.topic)?.latest_frame()?;
         let frame = frame.filter(|f| self.taken.fresh(input.topic, f.header().stamp_ns, f.header().seq));
         if let Some(f) = &frame {
             *self.newest = (*self.newest).max(f.header().stamp_ns);
@@ -70,10 +72,33 @@ impl Io<'_> {
     pub fn send_as<T: Message>(&mut self, output: Out<T>, key: &str, msg: &T) -> anyhow::Result<()> {
         let h = *msg.header();
         if self.sent.due(key, h.stamp_ns, h.seq) {
-            self.ports.outputs[output.index].put(msg)?;
+            self.ports.output(output.index, output.topic)?.put(msg)?;
             self.sent.done(key, h.stamp_ns, h.seq)?;
         }
         Ok(())
+    }
+
+    /// Sends a frame of `header` on `output`, its pixels written in place by `fill` (every byte:
+    /// the slot holds an earlier frame's), unless a predecessor of this process sent it (then
+    /// `fill` is not called). Returns whether the frame went out now.
+    pub fn send_frame(
+        &mut self,
+        output: FrameOut,
+        header: FrameHeader,
+        mut fill: impl FnMut(&mut [u8]) -> anyhow::Result<()>,
+    ) -> anyhow::Result<bool> {
+        if !self.sent.due(output.topic, header.stamp_ns, header.seq) {
+            return Ok(false);
+        }
+        self.ports.output(output.index, output.topic)?.put_frame(header, &mut fill)?;
+        self.sent.done(output.topic, header.stamp_ns, header.seq)?;
+        Ok(true)
+    }
+
+    /// Whether the runner keeps state across restarts (a supervised process; never in process):
+    /// a node that keeps more of its own (a journal) does so only then.
+    pub fn persistent(&self) -> bool {
+        self.persistent
     }
 
     /// The turn's time: the tick in deterministic mode; in real time the newest stamp taken so

@@ -28,12 +28,16 @@ impl FrameView for Rc<OwnedFrame> {
     }
 }
 
-type Queue<T> = Rc<RefCell<VecDeque<T>>>;
+/// A subscriber's queues, one per publisher, by the order the publishers came.
+type Queues<T> = Rc<RefCell<Vec<VecDeque<T>>>>;
 
-/// One topic's subscribers.
-struct Subscribers<T> {
-    queues: Vec<Queue<T>>,
+/// One topic's connections. As iceoryx2 does, each publisher reaches each subscriber through a
+/// queue of its own (of the topic's QoS buffer, the oldest dropped when full), and a subscriber
+/// takes its queues in the order the publishers came.
+struct Connections<T> {
     buffer: usize,
+    publishers: usize,
+    subscribers: Vec<Queues<T>>,
 }
 
 /// The topics of one process's nodes, by name.
@@ -47,13 +51,17 @@ impl Hub {
         &self,
         name: &'static str,
         buffer: usize,
-    ) -> anyhow::Result<Rc<RefCell<Subscribers<T>>>> {
+    ) -> anyhow::Result<Rc<RefCell<Connections<T>>>> {
         let mut topics = self.topics.borrow_mut();
         let entry = topics.entry(name).or_insert_with(|| {
-            Box::new(Rc::new(RefCell::new(Subscribers::<T> { queues: Vec::new(), buffer })))
+            Box::new(Rc::new(RefCell::new(Connections::<T> {
+                buffer,
+                publishers: 0,
+                subscribers: Vec::new(),
+            })))
         });
         entry
-            .downcast_ref::<Rc<RefCell<Subscribers<T>>>>()
+            .downcast_ref::<Rc<RefCell<Connections<T>>>>()
             .cloned()
             .ok_or_else(|| anyhow::anyhow!("topic {name} is used with two message types"))
     }
@@ -61,21 +69,29 @@ impl Hub {
     /// A new subscriber of `name`: it receives what is published from now on.
     pub fn subscribe<T: 'static>(&self, name: &'static str, buffer: usize) -> anyhow::Result<Receiver<T>> {
         let topic = self.topic::<T>(name, buffer)?;
-        let queue = Queue::default();
-        topic.borrow_mut().queues.push(Rc::clone(&queue));
-        Ok(Receiver { topic: name, queue })
+        let mut t = topic.borrow_mut();
+        let queues: Queues<T> = Rc::new(RefCell::new((0..t.publishers).map(|_| VecDeque::new()).collect()));
+        t.subscribers.push(Rc::clone(&queues));
+        Ok(Receiver { topic: name, queues })
     }
 
     /// A publisher on `name`.
     pub fn publisher<T: 'static>(&self, name: &'static str, buffer: usize) -> anyhow::Result<Sender<T>> {
-        Ok(Sender { topic: name, subscribers: self.topic::<T>(name, buffer)? })
+        let topic = self.topic::<T>(name, buffer)?;
+        let id = {
+            let mut t = topic.borrow_mut();
+            t.subscribers.iter().for_each(|q| q.borrow_mut().push(VecDeque::new()));
+            t.publishers += 1;
+            t.publishers - 1
+        };
+        Ok(Sender { topic: name, id, connections: topic })
     }
 }
 
-/// A subscriber's queue.
+/// A subscriber.
 pub struct Receiver<T> {
     topic: &'static str,
-    queue: Queue<T>,
+    queues: Queues<T>,
 }
 
 impl<T> Receiver<T> {
@@ -83,24 +99,27 @@ impl<T> Receiver<T> {
         self.topic
     }
 
-    /// Everything queued, oldest first.
+    /// Everything queued, publisher by publisher, each one's oldest first.
     pub fn drain(&self, mut f: impl FnMut(T)) -> usize {
-        let mut q = self.queue.borrow_mut();
-        let n = q.len();
-        q.drain(..).for_each(&mut f);
+        let mut queues = self.queues.borrow_mut();
+        let n = queues.iter().map(VecDeque::len).sum();
+        queues.iter_mut().for_each(|q| q.drain(..).for_each(&mut f));
         n
     }
 
-    /// The newest queued, older ones dropped.
+    /// The last of everything queued (taken as [`Receiver::drain`] takes it), the rest dropped.
     pub fn latest(&self) -> Option<T> {
-        self.queue.borrow_mut().drain(..).last()
+        let mut last = None;
+        self.drain(|m| last = Some(m));
+        last
     }
 }
 
-/// A publisher: each send goes into every subscriber's queue.
+/// A publisher: each send goes into its queue to every subscriber.
 pub struct Sender<T> {
     topic: &'static str,
-    subscribers: Rc<RefCell<Subscribers<T>>>,
+    id: usize,
+    connections: Rc<RefCell<Connections<T>>>,
 }
 
 impl<T: Clone> Sender<T> {
@@ -109,13 +128,42 @@ impl<T: Clone> Sender<T> {
     }
 
     pub fn send(&self, msg: T) {
-        let subs = self.subscribers.borrow();
-        for q in &subs.queues {
-            let mut q = q.borrow_mut();
-            q.push_back(msg.clone());
-            while q.len() > subs.buffer.max(1) {
-                q.pop_front();
+        let c = self.connections.borrow();
+        for queues in &c.subscribers {
+            let mut queues = queues.borrow_mut();
+            if let Some(q) = queues.get_mut(self.id) {
+                q.push_back(msg.clone());
+                while q.len() > c.buffer.max(1) {
+                    q.pop_front();
+                }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_publisher_has_its_own_queue_to_each_subscriber_taken_in_the_order_they_came() {
+        let hub = Hub::default();
+        let early = hub.subscribe::<u32>("t", 3).expect("subscribes");
+        let (a, b) = (hub.publisher::<u32>("t", 3).expect("a"), hub.publisher::<u32>("t", 3).expect("b"));
+        let late = hub.subscribe::<u32>("t", 3).expect("subscribes");
+        b.send(1);
+        a.send(2);
+        (10..15).for_each(|m| b.send(m));
+        // a's queue first; b's kept its newest 3 of 6.
+        for r in [&early, &late] {
+            let mut got = Vec::new();
+            assert_eq!(r.drain(|m| got.push(m)), 4);
+            assert_eq!(got, [2, 12, 13, 14]);
+        }
+        assert_eq!(early.latest(), None);
+        a.send(7);
+        b.send(8);
+        assert_eq!(late.latest(), Some(8));
+        assert!(hub.publisher::<u8>("t", 3).is_err(), "another type on the same topic");
     }
 }

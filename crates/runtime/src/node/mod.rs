@@ -17,7 +17,7 @@ mod ports;
 pub use bus::run;
 pub use inproc::{Hosted, host};
 pub use io::{FrameView, Io};
-pub use ports::{FrameIn, In, Out, Ports};
+pub use ports::{FrameIn, FrameOut, In, Out, Ports};
 
 use std::any::Any;
 
@@ -99,8 +99,21 @@ pub(crate) trait InputPort {
 
 /// An output port as a runner opened it.
 pub(crate) trait OutputPort {
+    fn topic(&self) -> &'static str;
+
     /// Sends `msg` (a `T` of the port's type).
-    fn put(&self, msg: &dyn Any) -> anyhow::Result<()>;
+    fn put(&self, _msg: &dyn Any) -> anyhow::Result<()> {
+        anyhow::bail!("{}: a frame output is sent with `send_frame`", self.topic())
+    }
+
+    /// Sends a frame of `header` whose pixels `fill` writes in place.
+    fn put_frame(
+        &self,
+        _header: harvey_msgs::FrameHeader,
+        _fill: &mut dyn FnMut(&mut [u8]) -> anyhow::Result<()>,
+    ) -> anyhow::Result<()> {
+        anyhow::bail!("{}: a message output is sent with `send`", self.topic())
+    }
 }
 
 /// A node's ports as a runner opened them, in the order [`Ports`] declared them: what [`Io`]
@@ -108,6 +121,20 @@ pub(crate) trait OutputPort {
 pub(crate) struct Wired {
     pub inputs: Vec<Box<dyn InputPort>>,
     pub outputs: Vec<Box<dyn OutputPort>>,
+}
+
+impl Wired {
+    /// Input `index`, or an error naming the topic (a handle another node's ports made).
+    fn input(&self, index: usize, topic: &str) -> anyhow::Result<&dyn InputPort> {
+        let port = self.inputs.get(index).filter(|p| p.topic() == topic);
+        port.map(|p| p.as_ref()).ok_or_else(|| anyhow::anyhow!("{topic}: not an input this node declared"))
+    }
+
+    /// Output `index`, or an error naming the topic.
+    fn output(&self, index: usize, topic: &str) -> anyhow::Result<&dyn OutputPort> {
+        let port = self.outputs.get(index).filter(|p| p.topic() == topic);
+        port.map(|p| p.as_ref()).ok_or_else(|| anyhow::anyhow!("{topic}: not an output this node declared"))
+    }
 }
 
 /// `out` as the `Vec<T>` a port of type `T` fills, or an error naming the topic.

@@ -1,12 +1,13 @@
 //! A node's declared ports: typed handles for the node, and what each runner needs to open them.
 
 use core::marker::PhantomData;
+use core::time::Duration;
 
 use harvey_bus::Bus;
 use harvey_msgs::Message;
 use harvey_msgs::topics::{FrameTopic, Topic};
 
-use super::inproc::FrameReceiver;
+use super::inproc::{FrameReceiver, FrameSender};
 use super::memory::Hub;
 use super::{InputPort, OutputPort};
 
@@ -27,6 +28,13 @@ pub struct Out<T> {
 /// A frame input of a node: camera frames read in place.
 #[derive(Debug, Clone, Copy)]
 pub struct FrameIn {
+    pub(crate) index: usize,
+    pub(crate) topic: &'static str,
+}
+
+/// A frame output of a node: camera frames written in place.
+#[derive(Debug, Clone, Copy)]
+pub struct FrameOut {
     pub(crate) index: usize,
     pub(crate) topic: &'static str,
 }
@@ -112,11 +120,34 @@ impl<T: Message> OutputSpec for Topic<T> {
     }
 }
 
-/// What a node declares: its inputs, in the order it takes them, and its outputs.
+/// A frame output as a runner opens it: its shared memory sized for the largest frame.
+struct FrameOutSpec {
+    topic: FrameTopic,
+    max_frame_bytes: usize,
+}
+
+impl OutputSpec for FrameOutSpec {
+    fn topic(&self) -> &'static str {
+        self.topic.name
+    }
+
+    fn open_bus(&self, bus: &Bus) -> anyhow::Result<Box<dyn OutputPort>> {
+        Ok(Box::new(bus.frame_publisher(self.topic, self.max_frame_bytes)?))
+    }
+
+    fn open_memory(&self, hub: &Hub) -> anyhow::Result<Box<dyn OutputPort>> {
+        let tx = hub.publisher(self.topic.name, self.topic.qos.buffer)?;
+        Ok(Box::new(FrameSender { tx, max_frame_bytes: self.max_frame_bytes }))
+    }
+}
+
+/// What a node declares: its inputs, in the order it takes them, its outputs, and how often it
+/// wakes without input in real time.
 #[derive(Default)]
 pub struct Ports {
     pub(crate) inputs: Vec<Box<dyn InputSpec>>,
     pub(crate) outputs: Vec<Box<dyn OutputSpec>>,
+    pub(crate) interval: Option<Duration>,
 }
 
 impl Ports {
@@ -136,6 +167,19 @@ impl Ports {
     pub fn output<T: Message>(&mut self, topic: Topic<T>) -> Out<T> {
         self.outputs.push(Box::new(topic));
         Out { index: self.outputs.len() - 1, topic: topic.name, _t: PhantomData }
+    }
+
+    /// Declares a frame output of frames up to `max_frame_bytes`; the node writes and sends
+    /// its frames with [`super::Io::send_frame`].
+    pub fn frames_out(&mut self, topic: FrameTopic, max_frame_bytes: usize) -> FrameOut {
+        self.outputs.push(Box::new(FrameOutSpec { topic, max_frame_bytes }));
+        FrameOut { index: self.outputs.len() - 1, topic: topic.name }
+    }
+
+    /// In real time, also gives the node a turn every `period` (a source with no input: a camera
+    /// at a fixed rate). A clock party's turns come from the chain only.
+    pub fn every(&mut self, period: Duration) {
+        self.interval = Some(period);
     }
 
     /// The topics declared, inputs then outputs (for errors and listings).
