@@ -162,6 +162,32 @@ fn the_reference_recording_replays_exactly_in_one_process() {
         "{}",
         text(&odd)
     );
+    // A recording whose messages another Harvey laid out otherwise is refused, naming the topic,
+    // before anything starts.
+    let foreign = dir.join("foreign.mcap");
+    let mut w = mcap::Writer::new(std::io::BufWriter::new(std::fs::File::create(&foreign).expect("create")))
+        .expect("writer");
+    let schema =
+        w.add_schema("harvey_msgs/msg/MotionCommand", "ros2msg", b"float32 distance_m\n").expect("schema");
+    let channel = w.add_channel(schema, "/vehicle/command", "cdr", &Default::default()).expect("channel");
+    let header =
+        mcap::records::MessageHeader { channel_id: channel, sequence: 1, log_time: 1, publish_time: 1 };
+    w.write_to_known_channel(&header, &[0, 1, 0, 0, 0, 0, 0, 0]).expect("message");
+    w.finish().expect("finish");
+    for how in [&["--in-process"][..], &[][..]] {
+        let out = common::harvey(&["replay", foreign.to_str().expect("utf8")])
+            .args(how)
+            .args(["--run-dir", dir.join("foreign").to_str().expect("utf8")])
+            .output()
+            .expect("runs");
+        assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+        assert!(
+            text(&out).contains("its messages are not this build's (/vehicle/command: harvey_msgs/msg/MotionCommand is defined otherwise than in this build)"),
+            "{}",
+            text(&out)
+        );
+        assert!(!dir.join("foreign").exists(), "nothing written");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

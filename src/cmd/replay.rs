@@ -36,6 +36,7 @@ pub fn run(recording: &Path, how: How, opts: LaunchArgs) -> anyhow::Result<i32> 
     let run_dir =
         opts.run_dir.clone().unwrap_or_else(|| recording.parent().unwrap_or(Path::new(".")).join("replay"));
     refuse_writing_over(recording, &run_dir)?;
+    refuse_other_messages(recording)?;
     // A live view is drawn from the Rerun file's stream.
     let file = prepare(recording, &run_dir, how.rrd || opts.live.is_some(), how.trust)?;
     let again = run_dir.join("run.mcap");
@@ -70,6 +71,19 @@ pub fn run(recording: &Path, how: How, opts: LaunchArgs) -> anyhow::Result<i32> 
     }
     let c = harvey_recording::compare::compare(recording, &again, &|_| true)?;
     Ok(report_comparison(&c, recording, &again))
+}
+
+/// An error, before anything is written, when the recording's messages are laid out otherwise
+/// than this build's: replayed, they would be read into a wrong answer.
+fn refuse_other_messages(recording: &Path) -> anyhow::Result<()> {
+    let differences = harvey_recording::schemas::differences(&Recording::open(recording)?)?;
+    anyhow::ensure!(
+        differences.is_empty(),
+        "{}: its messages are not this build's ({}): replay it with the Harvey that recorded it",
+        recording.display(),
+        differences.join("; ")
+    );
+    Ok(())
 }
 
 /// An error, before anything is written, when the recording is one of the files the replay would

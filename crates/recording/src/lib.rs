@@ -34,6 +34,7 @@ pub mod recover;
 pub mod rrd;
 mod salvage;
 pub mod same_file;
+pub mod schemas;
 mod stream;
 mod summary;
 pub mod ticks;

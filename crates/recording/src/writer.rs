@@ -124,6 +124,12 @@ impl Recorder {
         Ok(Channel(self.channels.len() - 1))
     }
 
+    /// A channel of any definition, for tests of readers of other versions' recordings.
+    #[cfg(test)]
+    pub(crate) fn add_channel_for_test(&mut self, topic: &str, def: &Def) {
+        let _ = self.add_channel(topic, def);
+    }
+
     /// A channel for a topic of `T`.
     pub fn channel<T: Ros2Msg>(&mut self, topic: &str) -> Result<Channel, RecordingError> {
         self.add_channel(topic, T::DEF)
