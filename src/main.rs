@@ -58,7 +58,7 @@ enum Cmd {
         trust_recording: bool,
         /// Run the services as nodes of this one process, one thread, with the same messages
         /// in the same order as over shared memory, and no processes (hundreds of times faster).
-        #[arg(long, conflicts_with_all = ["rrd", "live", "foxglove", "realtime"])]
+        #[arg(long, conflicts_with_all = ["live", "foxglove", "realtime"])]
         in_process: bool,
         #[command(flatten)]
         opts: LaunchArgs,

@@ -10,13 +10,15 @@ use clap::Parser;
 use harvey_cdr::{Ros2Msg, encode, encode_image};
 use harvey_msgs::{Message, Topic, topics};
 use harvey_recording::derive::{self, Derived, Deriver};
+use harvey_recording::draw::draw_recorded;
+use harvey_recording::rrd::RrdWriter;
 use harvey_recording::topics::{TopicVisitor, visit_message_topics};
 use harvey_recording::{Channel, ChunkCompression, Recorder, data_files};
 use harvey_runtime::node::memory::{Hub, OwnedFrame, Receiver};
 
 /// The recorder service's arguments, as its launch line gives them (`harvey-recorder`'s own;
-/// the in-process recorder writes the MCAP file only, so `--rrd`, `--live` and `--flush-ms` are
-/// accepted and not used).
+/// in process `--live` and `--flush-ms` are accepted and not used: the Rerun file is written
+/// whole, not streamed).
 #[derive(Parser)]
 #[command(name = "harvey-recorder")]
 pub struct RecorderArgs {
@@ -25,7 +27,7 @@ pub struct RecorderArgs {
     #[arg(long, default_value_t = 500)]
     flush_ms: u64,
     #[arg(long)]
-    rrd: Option<PathBuf>,
+    pub rrd: Option<PathBuf>,
     #[arg(long)]
     live: Option<String>,
     #[arg(long)]
@@ -122,6 +124,7 @@ type Item = (Channel, &'static str, u64, u64, Vec<u8>);
 /// and the derived topics overlap the next ticks' turns.
 struct Files {
     rec: Recorder,
+    rrd: Option<RrdWriter>,
     deriver: Deriver,
     derived: Vec<Channel>,
 }
@@ -137,6 +140,9 @@ impl Files {
                 let ch = derive::index(d.topic).and_then(|k| self.derived.get(k).copied());
                 let ch = ch.ok_or_else(|| anyhow::anyhow!("no channel for the derived topic {}", d.topic))?;
                 self.rec.record_encoded(ch, d.seq, d.stamp_ns, &d.data)?;
+            }
+            if let Some(rrd) = self.rrd.as_mut() {
+                draw_recorded(rrd, topic, &data).map_err(|e| anyhow::anyhow!("drawing {topic}: {e}"))?;
             }
         }
         Ok(())
@@ -190,7 +196,8 @@ impl Sink {
             hub.subscribe::<Rc<OwnedFrame>>(topics::CAMERA_FRAME.name, topics::CAMERA_FRAME.qos.buffer)?;
         taps.push(Box::new(FrameTap { rx, channel: frame_channel }));
         let derived = rec.derived_channels()?;
-        let mut files = Files { rec, deriver: Deriver::new(world.as_ref()), derived };
+        let rrd = args.rrd.as_ref().map(|p| RrdWriter::create(p, world.as_ref())).transpose()?;
+        let mut files = Files { rec, rrd, deriver: Deriver::new(world.as_ref()), derived };
         let (to_writer, ticks) = std::sync::mpsc::sync_channel::<Vec<Item>>(QUEUE);
         let writer = std::thread::Builder::new().name("mcap-writer".into()).spawn(move || {
             let mut scratch = Vec::new();
@@ -198,6 +205,9 @@ impl Sink {
                 files.write(items, &mut scratch)?;
             }
             files.rec.finish()?;
+            if let Some(rrd) = files.rrd {
+                rrd.finish()?;
+            }
             Ok(())
         })?;
         Ok(Self { taps, to_writer, writer, messages: 0, left_out: 0 })
