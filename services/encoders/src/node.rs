@@ -40,8 +40,11 @@ impl Node for Encoders {
 
 /// The node the arguments describe, its ports declared on `p`.
 pub fn build(p: &mut Ports) -> anyhow::Result<Encoders> {
+    let raw = p.input(topics::DRV_ENCODERS_RAW);
+    // In real time a turn is as late as the newest of these.
+    p.time_from(raw);
     Ok(Encoders {
-        raw: p.input(topics::DRV_ENCODERS_RAW),
+        raw,
         commands: p.input(topics::VEHICLE_COMMAND),
         reflexes: p.input(topics::VEHICLE_REFLEX),
         odometry: p.output(topics::ODOMETRY),

@@ -217,12 +217,15 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<ExecutiveNode> {
     let loaded = setup::load(&args.mission, args.world.as_deref(), args.seed)?;
     let mission = &loaded.mission;
     tracing::info!(description = %mission.description, steps = mission.steps.len(), "mission loaded");
+    let odometry = p.input(topics::ODOMETRY);
+    // In real time a turn is as late as the newest of these.
+    p.time_from(odometry);
     Ok(ExecutiveNode {
         sonar: p.input(topics::SONAR_RING),
         detections: p.input(topics::VISION_DETECTIONS),
         maps: p.input(topics::UMS_MAP),
         results: p.input(topics::VISION_RESULTS),
-        odometry: p.input(topics::ODOMETRY),
+        odometry,
         commands: p.output(topics::VEHICLE_COMMAND),
         status: p.output(topics::EXECUTIVE_STATUS),
         requests: p.output(topics::VISION_REQUESTS),

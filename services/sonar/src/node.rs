@@ -102,8 +102,11 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<Sonar> {
         dash_m: args.avoid_dash_ft * FT,
         stop_m: args.panic_stop_ft * FT,
     });
+    let raw = p.input(topics::DRV_SONAR_RAW);
+    // In real time a turn is as late as the newest of these.
+    p.time_from(raw);
     Ok(Sonar {
-        raw: p.input(topics::DRV_SONAR_RAW),
+        raw,
         odometry: p.input(topics::ODOMETRY),
         ring_out: p.output(topics::SONAR_RING),
         commands: p.output(topics::VEHICLE_REFLEX),

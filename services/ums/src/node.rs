@@ -145,8 +145,11 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<UmsNode> {
         fix_m: args.fix_m,
         fix_heading_rad: args.fix_heading_deg.to_radians(),
     };
+    let odometry = p.input(topics::ODOMETRY);
+    // In real time a turn is as late as the newest of these.
+    p.time_from(odometry);
     Ok(UmsNode {
-        odometry: p.input(topics::ODOMETRY),
+        odometry,
         sightings: p.input(topics::VISION_SIGHTINGS),
         fixes: p.input(topics::EXECUTIVE_POSE),
         map_out: p.output(topics::UMS_MAP),

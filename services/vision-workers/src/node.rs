@@ -179,8 +179,11 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<Workers> {
     let shard = shard(&args.shard)?;
     let own = own_request(&args)?;
     let world = harvey_world::World::load(&args.world)?;
+    let frames = p.frames(topics::CAMERA_FRAME);
+    // In real time a turn is as late as the newest of these.
+    p.time_from_frames(frames);
     Ok(Workers {
-        frames: p.frames(topics::CAMERA_FRAME),
+        frames,
         expectations: p.input(topics::UMS_EXPECTATIONS),
         requests: p.input(topics::VISION_REQUESTS),
         detections: p.output(topics::VISION_DETECTIONS),

@@ -82,6 +82,7 @@ pub fn run<N: Node>(
     let wired = Wired {
         inputs: ports.inputs.iter().map(|i| i.open_bus(&bus)).collect::<anyhow::Result<_>>()?,
         outputs: ports.outputs.iter().map(|o| o.open_bus(&bus)).collect::<anyhow::Result<_>>()?,
+        time_from: ports.time_from,
     };
     let mut rosout = Rosout::new(&bus, name)?;
     let pace = Pace::from_env(&bus)?;

@@ -160,6 +160,7 @@ pub fn host<N: Node + 'static>(
     let wired = Wired {
         inputs: ports.inputs.iter().map(|i| i.open_memory(hub)).collect::<anyhow::Result<_>>()?,
         outputs: ports.outputs.iter().map(|o| o.open_memory(hub)).collect::<anyhow::Result<_>>()?,
+        time_from: ports.time_from,
     };
     let state = node.start();
     Ok(Box::new(InProcess {

@@ -41,7 +41,9 @@ impl Io<'_> {
         self.ports.input(input.index, input.topic)?.take(out)?;
         let taken = &mut *self.taken;
         out.retain(|m| taken.fresh(input.topic, m.header().stamp_ns, m.header().seq));
-        *self.newest = out.iter().map(|m| m.header().stamp_ns).fold(*self.newest, u64::max);
+        if self.ports.times(input.index) {
+            *self.newest = out.iter().map(|m| m.header().stamp_ns).fold(*self.newest, u64::max);
+        }
         Ok(())
     }
 
@@ -50,7 +52,7 @@ impl Io<'_> {
     pub fn latest_frame(&mut self, input: FrameIn) -> anyhow::Result<Option<Box<dyn FrameView>>> {
         let frame = self.ports.input(input.index, input.topic)?.latest_frame()?;
         let frame = frame.filter(|f| self.taken.fresh(input.topic, f.header().stamp_ns, f.header().seq));
-        if let Some(f) = &frame {
+        if let Some(f) = frame.as_ref().filter(|_| self.ports.times(input.index)) {
             *self.newest = (*self.newest).max(f.header().stamp_ns);
         }
         Ok(frame)
@@ -102,7 +104,8 @@ impl Io<'_> {
     }
 
     /// The turn's time: the tick in deterministic mode; in real time the newest stamp taken so
-    /// far (of this turn or an earlier one).
+    /// far (of this turn or an earlier one) from the input that times the node's turns
+    /// ([`super::Ports::time_from`]), or from any input.
     pub fn now(&self) -> u64 {
         self.tick.unwrap_or(*self.newest)
     }

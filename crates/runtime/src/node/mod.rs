@@ -121,9 +121,16 @@ pub(crate) trait OutputPort {
 pub(crate) struct Wired {
     pub inputs: Vec<Box<dyn InputPort>>,
     pub outputs: Vec<Box<dyn OutputPort>>,
+    /// The input whose stamps time a real-time turn ([`Ports::time_from`]; none: every input's).
+    pub time_from: Option<usize>,
 }
 
 impl Wired {
+    /// Whether input `index`'s stamps time a turn.
+    fn times(&self, index: usize) -> bool {
+        self.time_from.is_none_or(|i| i == index)
+    }
+
     /// Input `index`, or an error naming the topic (a handle another node's ports made).
     fn input(&self, index: usize, topic: &str) -> anyhow::Result<&dyn InputPort> {
         let port = self.inputs.get(index).filter(|p| p.topic() == topic);

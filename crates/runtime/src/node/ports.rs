@@ -148,6 +148,8 @@ pub struct Ports {
     pub(crate) inputs: Vec<Box<dyn InputSpec>>,
     pub(crate) outputs: Vec<Box<dyn OutputSpec>>,
     pub(crate) interval: Option<Duration>,
+    /// The input whose stamps time a turn in real time (none: every input's).
+    pub(crate) time_from: Option<usize>,
 }
 
 impl Ports {
@@ -180,6 +182,17 @@ impl Ports {
     /// at a fixed rate). A clock party's turns come from the chain only.
     pub fn every(&mut self, period: Duration) {
         self.interval = Some(period);
+    }
+
+    /// In real time, a turn's time ([`super::Io::now`], its warnings' stamp) is the newest stamp
+    /// taken from `input` (the one that drives the node), not from any input.
+    pub fn time_from<T>(&mut self, input: In<T>) {
+        self.time_from = Some(input.index);
+    }
+
+    /// [`Ports::time_from`] for a frame input.
+    pub fn time_from_frames(&mut self, input: FrameIn) {
+        self.time_from = Some(input.index);
     }
 
     /// The topics declared, inputs then outputs (for errors and listings).
