@@ -51,6 +51,8 @@ pub fn differences(recording: &Recording) -> Result<Vec<String>, RecordingError>
             None => out.push(format!("{}: not a topic of this build", channel.topic)),
         }
     }
+    // The summary's channels come in no set order: said by topic.
+    out.sort();
     Ok(out)
 }
 
@@ -83,8 +85,8 @@ mod tests {
         assert_eq!(
             d,
             [
-                "/vehicle/command: harvey_msgs/msg/MotionCommand is defined otherwise than in this build",
-                "/odometry2: not a topic of this build"
+                "/odometry2: not a topic of this build",
+                "/vehicle/command: harvey_msgs/msg/MotionCommand is defined otherwise than in this build"
             ]
         );
         std::fs::remove_dir_all(&dir).ok();
