@@ -164,22 +164,33 @@ class Subscription:
                     f"all {qos.max_subscribers} subscriber slots of `{name}` are taken"
                 ) from None
             raise HarveyError(f"cannot subscribe to `{name}`: {why}") from None
-        try:
-            event = (
-                self._node.service_builder(service_name)
-                .event()
-                .max_notifiers(qos.max_publishers)
-                .max_listeners(qos.max_subscribers)
-                .max_nodes(qos.max_nodes)
-                .open()
-            )
-            self._listener = event.listener_builder().create()
-        except (iox2.EventOpenError, iox2.ListenerCreateError) as e:
-            raise HarveyError(
-                f"cannot listen to the wake-ups of `{name}`: {error_name(e)}"
-            ) from None
+        self._listener = self._listen(service_name, deadline)
         self._waitset = iox2.WaitSetBuilder.new().create(iox2.ServiceType.Ipc)
         self._guard = self._waitset.attach_notification(self._listener)
+
+    def _listen(self, service_name: Any, deadline: float) -> Any:
+        """The listener to the topic's wake-ups. A publisher creates its topic's event service
+        just after the topic itself: a subscriber that found the topic may be a moment early for
+        its wake-ups, so it waits for them until `deadline`, and a second even when not asked to."""
+        name, qos = self.topic.name, self.topic.qos
+        wakeups_by = max(deadline, time.monotonic() + 1.0)
+        while True:
+            try:
+                event = (
+                    self._node.service_builder(service_name)
+                    .event()
+                    .max_notifiers(qos.max_publishers)
+                    .max_listeners(qos.max_subscribers)
+                    .max_nodes(qos.max_nodes)
+                    .open()
+                )
+                return event.listener_builder().create()
+            except (iox2.EventOpenError, iox2.ListenerCreateError) as e:
+                why = error_name(e)
+                if why == "DoesNotExist" and time.monotonic() < wakeups_by:
+                    time.sleep(DISCOVERY_PERIOD_S)
+                    continue
+                raise HarveyError(f"cannot listen to the wake-ups of `{name}`: {why}") from None
 
     def take(self) -> Optional[Received]:
         """The oldest queued message, copied out of shared memory, or None when none is queued.
