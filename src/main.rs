@@ -25,6 +25,11 @@ enum Cmd {
     /// Run a mission (default: missions/default.toml), record it and print its summary.
     Run {
         mission: Option<PathBuf>,
+        /// Run every service in this one process, one thread, on in-memory topics (the
+        /// simulated DRV and the bridge on an in-memory serial line): the same recording as under
+        /// the supervisor, with no processes and no shared memory (deterministic launches).
+        #[arg(long, conflicts_with_all = ["live", "foxglove", "realtime"])]
+        in_process: bool,
         #[command(flatten)]
         opts: LaunchArgs,
     },
@@ -109,7 +114,7 @@ fn main() {
     let ansi = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let fmt =
         tracing_subscriber::fmt::layer().with_writer(std::io::stderr).with_target(false).with_ansi(ansi);
-    // Nodes run in process (`harvey replay --in-process`) send their turns' warnings to rosout,
+    // Nodes run in process (`harvey run|replay --in-process`) send their turns' warnings to rosout,
     // whatever RUST_LOG says, as their processes do (`harvey_runtime::init_logging`).
     let capture =
         harvey_runtime::rosout::CaptureLayer.with_filter(tracing_subscriber::filter::LevelFilter::WARN);
@@ -128,6 +133,7 @@ fn main() {
 fn run(cli: Cli) -> anyhow::Result<i32> {
     let cmd = cli.command.unwrap_or(Cmd::Run {
         mission: None,
+        in_process: false,
         opts: LaunchArgs {
             run_dir: None,
             prefix: harvey_bus::DEFAULT_PREFIX.into(),
@@ -137,7 +143,7 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
         },
     });
     match cmd {
-        Cmd::Run { mission, opts } => cmd::run::run(mission.as_deref(), &opts),
+        Cmd::Run { mission, in_process, opts } => cmd::run::run(mission.as_deref(), in_process, &opts),
         Cmd::Launch { file, opts } => cmd::launch::run(&file, &opts),
         Cmd::Supervise { file, opts } => cmd::launch::supervise(&file, &opts),
         Cmd::Replay { recording, check, rrd, trust_recording, in_process, opts } => {

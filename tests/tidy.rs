@@ -68,9 +68,18 @@ fn is_service(dir: &str) -> bool {
     dir.starts_with("services/")
 }
 
-/// Services whose nodes the CLI hosts for in-process runs (`src/cmd/inproc/registry.rs`).
-const HOSTED: [&str; 5] =
-    ["harvey-sonar", "harvey-encoders", "harvey-vision-workers", "harvey-ums", "harvey-executive"];
+/// Services the CLI hosts for in-process runs: the nodes (`src/cmd/inproc/registry.rs`), the
+/// simulated DRV and the bridge on their in-memory line (`src/cmd/inproc/drv.rs`).
+const HOSTED: [&str; 8] = [
+    "harvey-sonar",
+    "harvey-encoders",
+    "harvey-camera",
+    "harvey-vision-workers",
+    "harvey-ums",
+    "harvey-executive",
+    "harvey-sim-drv",
+    "harvey-denning-bridge",
+];
 
 /// The dependency rule: no `services/*` depends on another `services/*` (dev-dependencies
 /// included), no `crates/*` on any `services/*`, and the CLI (the root package) uses a service

@@ -43,6 +43,10 @@ pub struct SweepArgs {
     /// Bus prefix the runs' prefixes start with (default: sweep<pid>_).
     #[arg(long)]
     pub prefix: Option<String>,
+    /// Run each mission in one process (`harvey run --in-process`: the same recording, no
+    /// processes or shared memory, many times faster).
+    #[arg(long)]
+    pub in_process: bool,
 }
 
 /// A name safe as a folder name and in a bus prefix.
@@ -109,6 +113,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<i32> {
                 launch_text,
                 run_dir: out.join("runs").join(&tag),
                 prefix,
+                in_process: args.in_process,
             });
         }
     }

@@ -2,8 +2,7 @@
 //! simulator's true pose (`sim/truth`), or from a fixed pose at a fixed rate (`--pose`), or
 //! plays a folder of images (`--images`).
 
-mod folder;
-mod node;
+use harvey_camera::node;
 
 fn main() -> anyhow::Result<std::process::ExitCode> {
     let args = <node::Args as clap::Parser>::parse();

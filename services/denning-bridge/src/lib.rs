@@ -1,10 +1,14 @@
 //! The denning-bridge's logic: SI motion commands from the bus become DRV protocol commands (after
 //! checks), DRV reports become SI messages for the bus. The only place that knows DRV units.
-//! [`watchdog`] stops the vehicle when the executive falls silent.
+//! [`watchdog`] stops the vehicle when the executive falls silent; [`link`] is the bridge on a
+//! line, whatever carries the line and the topics.
 
+mod args;
+pub mod link;
 pub mod resume;
 pub mod watchdog;
 
+pub use args::Args;
 pub use resume::{BridgeState, Source};
 pub use watchdog::{SHUTDOWN_STOP_ID, WATCHDOG_STOP_ID, Watchdog};
 

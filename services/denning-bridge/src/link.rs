@@ -1,15 +1,16 @@
 //! The bridge's side of one DRV line: the line with the state that outlives it (checkpointed
-//! at every change), the bus ports, forwarding commands down the line once each, and putting
-//! the DRV's lines on the bus.
+//! at every change), forwarding commands down the line once each, and putting the DRV's lines
+//! on the bus. The line is any byte stream (a serial port, a pseudo-terminal, an in-process
+//! buffer) and the bus whatever [`BridgePorts`] a runner gives (iceoryx2, an in-process hub).
 
-use std::fs::File;
+use std::io::Write;
 
-use harvey_bus::{Lockstep, Publisher, Subscriber};
-use harvey_denning_bridge::{BridgeState, Outgoing, Source, WATCHDOG_STOP_ID, prioritise, to_drv};
 use harvey_drv_protocol::serial::write_frame;
-use harvey_drv_protocol::{Command, Line, encode};
-use harvey_msgs::{EncodersRaw, MissionStatus, MotionCommand, SonarRaw};
+use harvey_drv_protocol::{Command, Decoder, Line, encode};
+use harvey_msgs::{EncodersRaw, MotionCommand, SonarRaw};
 use harvey_runtime::{Checkpoint, Rosout};
+
+use crate::{BridgeState, Outgoing, Source, WATCHDOG_STOP_ID, prioritise, to_drv};
 
 /// Why the loop over one connection ended.
 pub enum Ended {
@@ -17,16 +18,28 @@ pub enum Ended {
     HungUp,
 }
 
+/// The bridge's topics as a runner opened them.
+pub trait BridgePorts {
+    /// The motion commands that came in since the last call, oldest first, into `batch`: the
+    /// reflexes' first, then the executive's. Returns how many are the reflexes'.
+    fn commands(&mut self, batch: &mut Vec<MotionCommand>) -> anyhow::Result<usize>;
+    fn encoders(&mut self, m: &EncodersRaw) -> anyhow::Result<()>;
+    fn sonar(&mut self, m: &SonarRaw) -> anyhow::Result<()>;
+    /// The DRV's `TK`: it has closed the reports of tick `time_ms`. In lockstep the bridge's
+    /// warnings since the last tick go out on `rosout` before the chain starts on the tick.
+    fn tick(&mut self, rosout: &mut Rosout, time_ms: u64) -> anyhow::Result<()>;
+}
+
 /// The line and the state that outlives it.
-pub struct Link<'a> {
-    pub port: File,
+pub struct Link<'a, P> {
+    pub port: P,
     pub state: &'a mut BridgeState,
     pub checkpoint: Option<&'a mut Checkpoint>,
     /// The bridge's warnings, published with each tick it starts (lockstep) or each wake-up.
     pub rosout: Rosout,
 }
 
-impl Link<'_> {
+impl<P: Write> Link<'_, P> {
     pub fn save(&mut self) -> anyhow::Result<()> {
         match self.checkpoint.as_deref_mut() {
             Some(c) => Ok(c.save(&*self.state)?),
@@ -42,28 +55,17 @@ impl Link<'_> {
     }
 }
 
-/// The bus ports of the bridge.
-pub struct Ports {
-    pub commands: Subscriber<MotionCommand>,
-    pub reflexes: Subscriber<MotionCommand>,
-    pub heartbeat: Subscriber<MissionStatus>,
-    pub encoders: Publisher<EncodersRaw>,
-    pub sonar: Publisher<SonarRaw>,
-}
-
 /// Sends the commands that arrived (each once, across restarts); in lockstep the round's lines
 /// are kept to send again. True if any came from the executive.
-pub fn forward(
-    link: &mut Link,
-    ports: &Ports,
+pub fn forward<P: Write>(
+    link: &mut Link<'_, P>,
+    ports: &mut impl BridgePorts,
     batch: &mut Vec<MotionCommand>,
     round: &mut Vec<String>,
 ) -> anyhow::Result<bool> {
     batch.clear();
     // The reflexes' commands first: an urgent stop among them pre-empts the batch.
-    ports.reflexes.drain(|c| batch.push(*c))?;
-    let reflexes = batch.len();
-    ports.commands.drain(|c| batch.push(*c))?;
+    let reflexes = ports.commands(batch)?;
     let executive = batch.len() > reflexes;
     let mut i = 0;
     batch.retain(|c| {
@@ -84,12 +86,58 @@ pub fn forward(
     Ok(executive)
 }
 
-/// Puts one line from the DRV on the bus.
-pub fn publish(
+/// Lockstep: the chain has finished tick `t_ms`. The commands that came in go down the line,
+/// closed by `SY t`, and the round is kept to send again after a restart. True if any came from
+/// the executive.
+pub fn sync<P: Write>(
+    link: &mut Link<'_, P>,
+    ports: &mut impl BridgePorts,
+    t_ms: u64,
+    batch: &mut Vec<MotionCommand>,
+    round: &mut Vec<String>,
+) -> anyhow::Result<bool> {
+    if !link.state.needs_sync(t_ms) {
+        return Ok(false);
+    }
+    round.clear();
+    let commanded = forward(link, ports, batch, round)?;
+    let sync = encode(&Line::Sync { time_ms: t_ms });
+    round.push(sync.clone());
+    (link.state.synced, link.state.round) = (Some(t_ms), std::mem::take(round));
+    link.save()?;
+    link.send_raw(&sync)?;
+    Ok(commanded)
+}
+
+/// Puts what the DRV sent (`bytes`, read off the line) on the bus, line by line; repeats of
+/// lines already published are dropped.
+pub fn receive<P: Write>(
     watchdog_ms: u64,
-    link: &mut Link,
-    lockstep: &Option<Lockstep>,
-    ports: &Ports,
+    link: &mut Link<'_, P>,
+    ports: &mut impl BridgePorts,
+    decoder: &mut Decoder,
+    bytes: &[u8],
+) -> anyhow::Result<()> {
+    let mut lines = Vec::new();
+    decoder.push(bytes, |frame| match frame {
+        Ok(line) => lines.push(line),
+        Err(e) => tracing::warn!("bad frame from the DRV: {e}"),
+    });
+    for line in lines {
+        if !link.state.fresh_from_drv(&line) {
+            tracing::debug!(?line, "a repeat of a line already published");
+            continue;
+        }
+        publish(watchdog_ms, link, ports, line)?;
+    }
+    Ok(())
+}
+
+/// Puts one line from the DRV on the bus.
+pub fn publish<P: Write>(
+    watchdog_ms: u64,
+    link: &mut Link<'_, P>,
+    ports: &mut impl BridgePorts,
     line: Line,
 ) -> anyhow::Result<()> {
     let out = match line {
@@ -102,24 +150,15 @@ pub fn publish(
     };
     let stamp_ns = match out {
         Outgoing::Encoders(m) => {
-            ports.encoders.send(&m)?;
+            ports.encoders(&m)?;
             Some(m.header.stamp_ns)
         }
         Outgoing::Sonar(m) => {
-            ports.sonar.send(&m)?;
+            ports.sonar(&m)?;
             Some(m.header.stamp_ns)
         }
         Outgoing::Tick { time_ms } => {
-            match lockstep {
-                Some(l) => {
-                    // What went wrong since the last tick goes out with this one, before the
-                    // chain starts on it.
-                    link.rosout.end(time_ms * 1_000_000)?;
-                    link.rosout.begin();
-                    l.finish(time_ms * 1_000_000)?
-                }
-                None => tracing::warn!(time_ms, "a tick mark from the DRV in real-time mode"),
-            }
+            ports.tick(&mut link.rosout, time_ms)?;
             None
         }
         Outgoing::Refused { id, reason } => {
@@ -143,7 +182,7 @@ pub fn publish(
 }
 
 /// Writes one frame to the DRV; a full line loses it, loudly.
-pub fn send(port: &mut File, line: &Line) -> anyhow::Result<()> {
+pub fn send(port: &mut impl Write, line: &Line) -> anyhow::Result<()> {
     if !write_frame(port, encode(line).as_bytes())? {
         tracing::error!(?line, "serial line full: frame not sent");
     }

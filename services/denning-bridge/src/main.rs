@@ -4,40 +4,18 @@
 
 use std::fs::{File, OpenOptions};
 use std::os::unix::fs::OpenOptionsExt;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
 use clap::Parser;
-use harvey_bus::{Bus, FdSource, Lockstep, Reoffers, Waiter, Wake};
-use harvey_denning_bridge::{BridgeState, SHUTDOWN_STOP_ID};
+use harvey_bus::{Bus, FdSource, Lockstep, Publisher, Reoffers, Subscriber, Waiter, Wake};
+use harvey_denning_bridge::link::{BridgePorts, Ended, Link, forward, receive, send, sync};
+use harvey_denning_bridge::{Args, BridgeState, SHUTDOWN_STOP_ID};
 use harvey_drv_protocol::serial::{make_raw, read_available};
-use harvey_drv_protocol::{Command, Decoder, Line, encode};
-use harvey_msgs::topics;
-use harvey_runtime::Checkpoint;
-
-mod link;
-
-use link::{Ended, Link, Ports, forward, publish, send};
-
-#[derive(Parser)]
-#[command(about = "Bridge between a Denning DRV serial line and the Harvey bus")]
-struct Args {
-    /// Serial device of the DRV (or the simulated DRV's pseudo-terminal link).
-    #[arg(long)]
-    device: PathBuf,
-    /// After a panic-stop, refuse motion commands for this long (simulated or sensor time).
-    #[arg(long, default_value_t = 200)]
-    panic_hold_ms: u64,
-    /// Stop the vehicle when neither a status nor a command has come from the executive for
-    /// this long (vehicle time, from the DRV's reports), and on shutdown.
-    #[arg(long, default_value_t = 200)]
-    watchdog_ms: u64,
-    /// When the line hangs up (or is not there yet), keep trying to open it for this long
-    /// before giving up.
-    #[arg(long, default_value_t = 10.0)]
-    reopen_s: f64,
-}
+use harvey_drv_protocol::{Command, Decoder, Line};
+use harvey_msgs::{EncodersRaw, MissionStatus, MotionCommand, SonarRaw, topics};
+use harvey_runtime::{Checkpoint, Rosout};
 
 /// Room for the bridge's state and a round's lines.
 const SLOT_BYTES: usize = 16 << 10;
@@ -141,10 +119,60 @@ fn open_line(device: &Path, wait: Duration) -> anyhow::Result<File> {
 /// How often a missing line is tried again.
 const REOPEN_POLL: Duration = Duration::from_millis(20);
 
+/// The bus ports of the bridge.
+struct Ports {
+    commands: Subscriber<MotionCommand>,
+    reflexes: Subscriber<MotionCommand>,
+    heartbeat: Subscriber<MissionStatus>,
+    encoders: Publisher<EncodersRaw>,
+    sonar: Publisher<SonarRaw>,
+}
+
+/// The ports with the bridge's place in the clock chain (lockstep).
+struct OnBus<'a> {
+    ports: &'a Ports,
+    lockstep: &'a Option<Lockstep>,
+}
+
+impl BridgePorts for OnBus<'_> {
+    fn commands(&mut self, batch: &mut Vec<MotionCommand>) -> anyhow::Result<usize> {
+        self.ports.reflexes.drain(|c| batch.push(*c))?;
+        let reflexes = batch.len();
+        self.ports.commands.drain(|c| batch.push(*c))?;
+        Ok(reflexes)
+    }
+
+    fn encoders(&mut self, m: &EncodersRaw) -> anyhow::Result<()> {
+        self.ports.encoders.send(m)?;
+        Ok(())
+    }
+
+    fn sonar(&mut self, m: &SonarRaw) -> anyhow::Result<()> {
+        self.ports.sonar.send(m)?;
+        Ok(())
+    }
+
+    fn tick(&mut self, rosout: &mut Rosout, time_ms: u64) -> anyhow::Result<()> {
+        match self.lockstep {
+            Some(l) => {
+                // What went wrong since the last tick goes out with this one, before the
+                // chain starts on it.
+                rosout.end(time_ms * 1_000_000)?;
+                rosout.begin();
+                Ok(l.finish(time_ms * 1_000_000)?)
+            }
+            None => {
+                tracing::warn!(time_ms, "a tick mark from the DRV in real-time mode");
+                Ok(())
+            }
+        }
+    }
+}
+
 /// The bridge's loop over one connection, until shutdown or the line hangs up.
 fn run(
     args: &Args,
-    link: &mut Link,
+    link: &mut Link<'_, File>,
     lockstep: &Option<Lockstep>,
     waiter: &Waiter,
     ports: &Ports,
@@ -166,6 +194,7 @@ fn run(
         Some(_) => Some(waiter.attach(reoffers)?),
         None => None,
     };
+    let mut on_bus = OnBus { ports, lockstep };
     let mut decoder = Decoder::new();
     let (mut buf, mut batch, mut ticks, mut round) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     link.rosout.begin();
@@ -182,21 +211,11 @@ fn run(
                 ticks.clear();
                 l.finished(|t| ticks.push(t))?;
                 for &t in &ticks {
-                    let t_ms = t / 1_000_000;
-                    if !link.state.needs_sync(t_ms) {
-                        continue;
-                    }
-                    round.clear();
-                    commanded |= forward(link, ports, &mut batch, &mut round)?;
-                    let sync = encode(&Line::Sync { time_ms: t_ms });
-                    round.push(sync.clone());
-                    (link.state.synced, link.state.round) = (Some(t_ms), std::mem::take(&mut round));
-                    link.save()?;
-                    link.send_raw(&sync)?;
+                    commanded |= sync(link, &mut on_bus, t / 1_000_000, &mut batch, &mut round)?;
                 }
             }
             None => {
-                commanded = forward(link, ports, &mut batch, &mut round)?;
+                commanded = forward(link, &mut on_bus, &mut batch, &mut round)?;
                 round.clear();
             }
         }
@@ -212,18 +231,7 @@ fn run(
         if !read_available(&mut link.port, &mut buf).context("reading the DRV line")? {
             return Ok(Ended::HungUp);
         }
-        let mut lines = Vec::new();
-        decoder.push(&buf, |frame| match frame {
-            Ok(line) => lines.push(line),
-            Err(e) => tracing::warn!("bad frame from the DRV: {e}"),
-        });
-        for line in lines {
-            if !link.state.fresh_from_drv(&line) {
-                tracing::debug!(?line, "a repeat of a line already published");
-                continue;
-            }
-            publish(args.watchdog_ms, link, lockstep, ports, line)?;
-        }
+        receive(args.watchdog_ms, link, &mut on_bus, &mut decoder, &buf)?;
         // Real time: no tick marks; the warnings go out stamped with the vehicle's time.
         if lockstep.is_none() {
             link.rosout.end(link.state.watchdog.now_ms() * 1_000_000)?;

@@ -8,15 +8,15 @@
 //! runs it) or after it (a repeated `SY` for the tick before gets the saved lines again; the
 //! bridge drops reports it has already published).
 
-use std::fs::File;
+use std::io::Write;
 
-use harvey_bus::Publisher;
 use harvey_drv_protocol::serial::write_frame;
 use harvey_drv_protocol::{Command, Line, encode};
 use harvey_msgs::{Header, TruePose};
 use harvey_runtime::Checkpoint;
-use harvey_sim_drv::watchdog::HostWatchdog;
-use harvey_sim_drv::{SimDrv, SimState};
+
+use crate::watchdog::HostWatchdog;
+use crate::{SimDrv, SimState};
 
 /// Room for the state and a round's lines.
 pub const SLOT_BYTES: usize = 16 << 10;
@@ -31,11 +31,11 @@ struct Saved {
     truth_sent: bool,
 }
 
-/// The simulator on its line.
-pub struct Drive {
+/// The simulator on its line; `T` puts the true pose on the bus (or an in-process hub).
+pub struct Drive<T> {
     pub sim: SimDrv,
     pub watchdog: HostWatchdog,
-    truth_pub: Publisher<TruePose>,
+    truth_out: T,
     tick_ms: u64,
     checkpoint: Option<Checkpoint>,
     round: Vec<String>,
@@ -45,12 +45,12 @@ pub struct Drive {
     pub dropped_frames: u64,
 }
 
-impl Drive {
+impl<T: FnMut(&TruePose) -> anyhow::Result<()>> Drive<T> {
     /// A simulator, restored from its checkpoint if an earlier one of this run left one.
     pub fn new(
         mut sim: SimDrv,
         watchdog: HostWatchdog,
-        truth_pub: Publisher<TruePose>,
+        truth_out: T,
         tick_ms: u64,
         mut checkpoint: Option<Checkpoint>,
     ) -> anyhow::Result<Self> {
@@ -65,7 +65,7 @@ impl Drive {
         let d = Self {
             sim,
             watchdog,
-            truth_pub,
+            truth_out,
             tick_ms,
             checkpoint,
             round,
@@ -77,7 +77,7 @@ impl Drive {
     }
 
     /// A frame from the host.
-    pub fn on_line(&mut self, line: &mut File, l: Line, lockstep: bool) -> anyhow::Result<()> {
+    pub fn on_line(&mut self, line: &mut impl Write, l: Line, lockstep: bool) -> anyhow::Result<()> {
         self.watchdog.feed(self.sim.time_ms());
         match l {
             Line::Command(cmd) if lockstep => self.pending.push(cmd),
@@ -93,7 +93,7 @@ impl Drive {
     }
 
     /// `SY t`: the host has finished tick `t`.
-    fn on_sync(&mut self, line: &mut File, time_ms: u64) -> anyhow::Result<()> {
+    fn on_sync(&mut self, line: &mut impl Write, time_ms: u64) -> anyhow::Result<()> {
         let commands = std::mem::take(&mut self.pending);
         let now = self.sim.time_ms();
         if time_ms == now {
@@ -125,7 +125,7 @@ impl Drive {
     }
 
     /// Real time: the next tick, with its reports sent at once.
-    pub fn tick_now(&mut self, line: &mut File) -> anyhow::Result<()> {
+    pub fn tick_now(&mut self, line: &mut impl Write) -> anyhow::Result<()> {
         self.guard();
         let out = self.sim.tick();
         self.round = out.reports.iter().map(|r| encode(&Line::Report(*r))).collect();
@@ -148,7 +148,7 @@ impl Drive {
 
     fn publish_truth(&mut self) -> anyhow::Result<()> {
         let stamp_ns = self.sim.time_ms() * 1_000_000;
-        self.truth_pub.send(&TruePose {
+        (self.truth_out)(&TruePose {
             header: Header::new(stamp_ns / (self.tick_ms * 1_000_000), stamp_ns),
             world_from_robot: self.sim.truth(),
         })?;
@@ -156,14 +156,14 @@ impl Drive {
         self.save()
     }
 
-    fn resend(&mut self, line: &mut File) -> anyhow::Result<()> {
+    fn resend(&mut self, line: &mut impl Write) -> anyhow::Result<()> {
         for frame in &self.round {
             self.dropped_frames += u64::from(!write_frame(line, frame.as_bytes())?);
         }
         Ok(())
     }
 
-    fn send(&mut self, line: &mut File, frame: &str) -> anyhow::Result<()> {
+    fn send(&mut self, line: &mut impl Write, frame: &str) -> anyhow::Result<()> {
         self.dropped_frames += u64::from(!write_frame(line, frame.as_bytes())?);
         Ok(())
     }

@@ -2,12 +2,16 @@
 //! world with the terrain error model, and produces what a DRV reports (shaft encoders and sonar
 //! banks, in the DRV's units), plus the true pose for the simulator's own topic.
 //!
-//! `main.rs` puts it on a pseudo-terminal and paces it; nothing here reads a clock.
+//! [`drive::Drive`] runs it on a line, tick by tick; `main.rs` puts that on a pseudo-terminal
+//! and paces it; nothing here reads a clock.
 
+mod args;
+pub mod drive;
 pub mod motion;
 pub mod sonar;
 pub mod watchdog;
 
+pub use args::Args;
 use harvey_drv_protocol::{Command, NakReason, Report};
 use harvey_world::World;
 

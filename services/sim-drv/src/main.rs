@@ -2,7 +2,6 @@
 //! terminal's slave end (a symlink at `--pty`) as if it were the DRV's serial port.
 
 use std::fs::File;
-use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::Context;
@@ -11,60 +10,14 @@ use harvey_bus::{Bus, FdSource, Waiter, Wake};
 use harvey_drv_protocol::Decoder;
 use harvey_drv_protocol::serial::{make_raw, read_available, set_nonblocking};
 use harvey_msgs::topics;
-use harvey_sim_drv::SimDrv;
+use harvey_sim_drv::Args;
+use harvey_sim_drv::drive::{self, Drive};
 use harvey_sim_drv::watchdog::HostWatchdog;
-
-mod drive;
-
-use drive::Drive;
-
-#[derive(Parser)]
-#[command(about = "Simulated Denning DRV speaking the DRV protocol on a pseudo-terminal")]
-struct Args {
-    /// World file to drive in.
-    #[arg(long)]
-    world: PathBuf,
-    /// Where to put the symlink to the terminal the bridge opens.
-    #[arg(long)]
-    pty: PathBuf,
-    /// Simulated time per tick.
-    #[arg(long, default_value_t = 50)]
-    tick_ms: u64,
-    /// Simulated seconds per wall-clock second.
-    #[arg(long, default_value_t = 1.0)]
-    speedup: f64,
-    /// Seed of the error model.
-    #[arg(long, default_value_t = 1)]
-    seed: u64,
-    /// Where the robot starts, `x_m,y_m,heading_deg`, instead of the world's `[start]` (a
-    /// mission's own start).
-    #[arg(long)]
-    start: Option<harvey_world::Pose2>,
-    /// A launch file whose `[[mover]]` tables put moving things in the world.
-    #[arg(long)]
-    movers: Option<PathBuf>,
-    /// Stop when no frame has come from the host for this long of simulated time (the DRV's
-    /// watchdog; in lockstep every tick's `SY` feeds it).
-    #[arg(long, default_value_t = 200)]
-    watchdog_ms: u64,
-}
 
 fn main() -> anyhow::Result<()> {
     harvey_runtime::init_logging();
     let args = Args::parse();
-    anyhow::ensure!(args.tick_ms > 0 && args.speedup > 0.0, "--tick-ms and --speedup must be positive");
-    // The world as built, not as mapped: the robot's services keep the file (`[map_error]`).
-    let mut world = harvey_world::World::load(&args.world)?.as_built(args.seed);
-    if let Some(start) = args.start {
-        world.start = start;
-    }
-    for p in world.place_poles(args.seed)? {
-        tracing::info!(code = p.code, x_m = p.at[0], y_m = p.at[1], "pole placed");
-    }
-    if let Some(file) = &args.movers {
-        world.add_movers(harvey_world::load_movers(file)?);
-    }
-    let sim = SimDrv::new(world, args.tick_ms, args.seed);
+    let sim = args.simulator()?;
 
     let bus = Bus::join("sim-drv")?;
     let truth_pub = bus.publisher(topics::SIM_TRUTH)?;
@@ -94,8 +47,11 @@ fn main() -> anyhow::Result<()> {
     // releases the next tick. Real time: a tick every `tick_ms / speedup` of wall time.
     let lockstep = harvey_bus::lockstep_from_env();
     let checkpoint = harvey_runtime::Checkpoint::from_env("sim-drv", drive::SLOT_BYTES)?;
-    let mut drive =
-        Drive::new(sim, HostWatchdog::new(args.watchdog_ms), truth_pub, args.tick_ms, checkpoint)?;
+    let truth = |m: &harvey_msgs::TruePose| -> anyhow::Result<()> {
+        truth_pub.send(m)?;
+        Ok(())
+    };
+    let mut drive = Drive::new(sim, HostWatchdog::new(args.watchdog_ms), truth, args.tick_ms, checkpoint)?;
     let period = Duration::from_secs_f64(args.tick_ms as f64 / 1000.0 / args.speedup);
     let mut next_tick = Instant::now() + period;
     let mut decoder = Decoder::new();

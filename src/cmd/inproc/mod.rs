@@ -1,26 +1,28 @@
-//! `harvey replay --in-process`: a recording's services run again as nodes of this one process,
-//! one thread, on a hub of in-memory topics; each tick the recorded inputs go out, then each
-//! clock party takes its turn in the chain's order (the recorder's turn writes the new
-//! recording), exactly as the multi-process replay hands the turns round over shared memory.
+//! In process: a launch's services as nodes of this one process, one thread, on a hub of
+//! in-memory topics. `harvey replay --in-process` (here): each tick the recorded inputs go out,
+//! then each clock party takes its turn in the chain's order (the recorder's turn writes the new
+//! recording), exactly as the multi-process replay hands the turns round over shared memory;
+//! `harvey run --in-process` ([`run`]): the same with the simulated DRV and the bridge as the
+//! clock master.
 
+mod chain;
+mod drv;
 mod registry;
+mod run;
 mod sink;
 
 use std::path::Path;
 use std::rc::Rc;
 use std::time::Instant;
 
-use anyhow::Context;
-use clap::Parser;
 use harvey_msgs::{EncodersRaw, LogLine, SonarRaw, TruePose, topics};
 use harvey_recording::Recording;
 use harvey_recording::ticks::{Input, for_each_tick};
-use harvey_runtime::End;
-use harvey_runtime::node::Hosted;
 use harvey_runtime::node::memory::{Hub, OwnedFrame, Sender};
 use harvey_supervisor::LaunchFile;
 
-use sink::{RecorderArgs, Sink};
+use chain::Chain;
+pub use run::run;
 
 /// The recorded inputs' publishers (the replayer's ports).
 struct Inputs {
@@ -67,13 +69,6 @@ impl Inputs {
     }
 }
 
-/// A party of the clock chain, in process.
-enum Party {
-    Replayer,
-    Recorder,
-    Node(Box<dyn Hosted>),
-}
-
 /// What a replay in process did.
 pub struct Replayed {
     pub ticks: u64,
@@ -96,82 +91,31 @@ pub fn replay(recording: &Path, launch_path: &Path, run_dir: &Path) -> anyhow::R
     let vars = harvey_supervisor::variables(&launch, run_dir, "in-process")?;
     let hub = Hub::default();
     let inputs = Inputs::open(&hub)?;
-    let mut sink = None;
-    let mut nodes = Vec::new();
-    for s in &launch.services {
-        let (name, binary, args) = (s.name(), s.binary_name(), harvey_supervisor::expand_args(s, &vars));
-        match binary.as_str() {
-            "harvey-replayer" => {}
-            "harvey-recorder" => {
-                let argv = std::iter::once(binary.clone()).chain(args);
-                let a = RecorderArgs::try_parse_from(argv)
-                    .map_err(|e| anyhow::anyhow!("service {name}: its arguments: {e}"))?;
-                sink = Some((name.to_owned(), Sink::open(&a, &hub)?));
-            }
-            _ => nodes.push(registry::node(name, &binary, &args, &hub)?),
-        }
-    }
-    let (recorder, mut sink) =
-        sink.ok_or_else(|| anyhow::anyhow!("{}: no recorder", launch_path.display()))?;
-    let mut chain = Vec::new();
-    for party in launch.clock_chain() {
-        chain.push(match party.as_str() {
-            "replayer" => Party::Replayer,
-            p if p == recorder => Party::Recorder,
-            p => {
-                let at = nodes.iter().position(|n| n.name() == p);
-                let at = at.ok_or_else(|| anyhow::anyhow!("clock party {p} is not a service"))?;
-                Party::Node(nodes.swap_remove(at))
-            }
-        });
-    }
-    let off: Vec<&str> = nodes.iter().map(|n| n.name()).collect();
-    anyhow::ensure!(off.is_empty(), "services off the clock chain cannot run in process: {}", off.join(", "));
+    let (mut chain, _replayer) = Chain::open(&launch, &vars, &hub, &["harvey-replayer"])?;
     // As the replayer does: the whole recording is checked before any service sees it.
     let rec = Recording::open(recording)?;
     let contents = for_each_tick::<anyhow::Error>(&rec, |_, _| Ok(()))?;
     anyhow::ensure!(contents.ticks > 0, "{}: holds no inputs to replay", recording.display());
-    for party in chain.iter_mut() {
-        if let Party::Node(n) = party {
-            n.begin().with_context(|| format!("service {}, starting", n.name()))?;
-        }
-    }
+    chain.begin()?;
 
-    let mut spent = vec![0.0; chain.len()];
     let started = Instant::now();
     let ran = for_each_tick::<anyhow::Error>(&rec, |tick, ins| {
-        for (party, spent) in chain.iter_mut().zip(spent.iter_mut()) {
-            let turn = Instant::now();
-            match party {
-                Party::Replayer => inputs.send(ins)?,
-                Party::Recorder => sink.record_tick(tick)?,
-                Party::Node(n) if !n.finished() => {
-                    let name = n.name().to_owned();
-                    n.step(tick).with_context(|| format!("service {name}, tick at {tick} ns"))?
-                }
-                Party::Node(_) => {}
-            }
-            *spent += turn.elapsed().as_secs_f64();
-        }
-        Ok(())
+        let turn = Instant::now();
+        inputs.send(ins)?;
+        chain.master_spent(turn.elapsed().as_secs_f64());
+        chain.turns(tick)
     });
     if let Err(e) = ran {
         // The writer's own error, if it stopped first, says more than a closed channel.
-        return Err(sink.finish().err().unwrap_or(e).context(recording.display().to_string()));
+        return Err(chain.into_sink().finish().err().unwrap_or(e).context(recording.display().to_string()));
     }
-    let names = launch.clock_chain();
-    for party in chain.iter_mut() {
-        if let Party::Node(n) = party {
-            let end = if n.finished() { End::Finished } else { End::Stopped };
-            let code = n.stop(end).with_context(|| format!("service {}, stopping", n.name()))?;
-            anyhow::ensure!(code == 0 || end == End::Finished, "{} stopped with code {code}", n.name());
-        }
-    }
+    chain.stop()?;
+    let turns = chain.turn_times();
+    let sink = chain.into_sink();
     let (messages, left_out) = (sink.messages, sink.left_out);
     sink.finish()?;
     // The file finished is part of the replay's time (its writer runs beside the turns).
     let wall_s = started.elapsed().as_secs_f64();
     let sim_s = (contents.last_ns - contents.first_ns) as f64 / 1e9;
-    let turns = names.into_iter().zip(spent).collect();
     Ok(Replayed { ticks: contents.ticks, messages, sim_s, wall_s, left_out, turns })
 }

@@ -6,8 +6,14 @@ use harvey_runtime::node::memory::Hub;
 use harvey_runtime::node::{Hosted, host};
 
 /// Services with a node registered for in-process runs (by executable name).
-pub const IN_PROCESS: [&str; 5] =
-    ["harvey-sonar", "harvey-encoders", "harvey-vision-workers", "harvey-ums", "harvey-executive"];
+pub const IN_PROCESS: [&str; 6] = [
+    "harvey-sonar",
+    "harvey-encoders",
+    "harvey-camera",
+    "harvey-vision-workers",
+    "harvey-ums",
+    "harvey-executive",
+];
 
 /// The node of service `name` (executable `binary`) with arguments `args`, its ports on `hub`.
 pub fn node(name: &str, binary: &str, args: &[String], hub: &Hub) -> anyhow::Result<Box<dyn Hosted>> {
@@ -19,6 +25,10 @@ pub fn node(name: &str, binary: &str, args: &[String], hub: &Hub) -> anyhow::Res
             host(name, hub, |p| harvey_sonar::node::build(a, p))
         }
         "harvey-encoders" => host(name, hub, harvey_encoders::node::build),
+        "harvey-camera" => {
+            let a = harvey_camera::node::Args::try_parse_from(argv()).map_err(parsed)?;
+            host(name, hub, |p| harvey_camera::node::build(a, p))
+        }
         "harvey-vision-workers" => {
             let a = harvey_vision_workers::node::Args::try_parse_from(argv()).map_err(parsed)?;
             host(name, hub, |p| harvey_vision_workers::node::build(a, p))

@@ -29,6 +29,8 @@ pub struct Job {
     pub launch_text: String,
     pub run_dir: PathBuf,
     pub prefix: String,
+    /// Run it in one process (`harvey run --in-process`).
+    pub in_process: bool,
 }
 
 /// A run that ended by itself.
@@ -64,7 +66,8 @@ struct Running {
     log: PathBuf,
 }
 
-/// Starts `job` as `exe run LAUNCH --run-dir D --prefix P`, its output in `D/harvey-run.log`.
+/// Starts `job` as `exe run LAUNCH --run-dir D --prefix P [--in-process]`, its output in
+/// `D/harvey-run.log`.
 fn start(exe: &Path, job: Job) -> anyhow::Result<Running> {
     if job.run_dir.exists() {
         std::fs::remove_dir_all(&job.run_dir)?;
@@ -80,6 +83,7 @@ fn start(exe: &Path, job: Job) -> anyhow::Result<Running> {
         .arg(&job.run_dir)
         .arg("--prefix")
         .arg(&job.prefix)
+        .args(job.in_process.then_some("--in-process"))
         .stdin(Stdio::null())
         .stdout(out.try_clone()?)
         .stderr(out)
