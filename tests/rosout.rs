@@ -37,7 +37,7 @@ fn printed(stderr: &str) -> Vec<(String, LogLevel, String)> {
 fn every_warning_a_service_printed_is_on_rosout_once_stamped_with_a_tick() {
     // ptrans in the shipped (nominal) world: the UMS refuses false matches (one of them 140
     // frames in a row) and the executive relocates when the UMS reports the robot lost.
-    let run = common::run_mission("missions/ptrans.toml", "rosout");
+    let run = common::run_mission_processes("missions/ptrans.toml", "rosout");
     assert!(run.status.success(), "{}\n{}", run.stdout, run.stderr);
     let (mut lines, mut ticks) = (Vec::new(), std::collections::BTreeSet::new());
     for m in mcap::MessageStream::new(&run.mcap).expect("mcap") {

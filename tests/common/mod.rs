@@ -121,12 +121,25 @@ impl Drop for MissionRun {
     }
 }
 
-/// Runs `mission` (a path from the repository root, or absolute); checks nothing of the
-/// mission, only that its shared memory is gone afterwards.
+/// Runs `mission` (a path from the repository root, or absolute) in one process (`harvey run
+/// --in-process`: the recording the processes make, `tests/in_process_run.rs`); checks nothing
+/// of the mission.
 #[allow(dead_code)]
 pub fn run_mission(mission: &str, tag: &str) -> MissionRun {
+    run_mission_with(mission, tag, &["--in-process"])
+}
+
+/// Runs `mission` under the supervisor, as processes; checks nothing of the mission, only that
+/// its shared memory is gone afterwards.
+#[allow(dead_code)]
+pub fn run_mission_processes(mission: &str, tag: &str) -> MissionRun {
+    run_mission_with(mission, tag, &[])
+}
+
+fn run_mission_with(mission: &str, tag: &str, how: &[&str]) -> MissionRun {
     let (prefix, dir) = (unique_prefix(tag), scratch(tag));
     let out = harvey(&["run", mission, "--prefix", &prefix, "--run-dir", dir.to_str().expect("utf8")])
+        .args(how)
         .output()
         .expect("runs");
     assert_eq!(shm_leftovers(&prefix), Vec::<String>::new());
@@ -139,15 +152,16 @@ pub fn run_mission(mission: &str, tag: &str) -> MissionRun {
     }
 }
 
-/// Runs `mission` at `seed` under a sensor condition (`conditions/NAME.toml`), as `harvey sweep`
-/// does: the run's recording and its `harvey run` output (as stdout; the sweep's own output as
+/// Runs `mission` at `seed` under a sensor condition (`conditions/NAME.toml`), as `harvey sweep
+/// --in-process` does: the run's recording and its `harvey run` output (as stdout; the sweep's own output as
 /// stderr); the status is the sweep's (success when the run reached its goal).
 #[allow(dead_code)]
 pub fn run_mission_under(mission: &str, condition: &str, seed: u64, tag: &str) -> MissionRun {
     let (prefix, dir) = (unique_prefix(tag), scratch(tag));
     let seeds = seed.to_string();
-    let args = ["sweep", mission, "--seeds", &seeds, "--conditions", condition, "--jobs", "1", "--keep"];
+    let args = ["sweep", mission, "--seeds", &seeds, "--conditions", condition];
     let out = harvey(&args)
+        .args(["--jobs", "1", "--keep", "--in-process"])
         .args(["--out", dir.to_str().expect("utf8"), "--prefix", &prefix])
         .output()
         .expect("runs");
