@@ -51,8 +51,7 @@ pub fn run(recording: &Path, how: How, opts: LaunchArgs) -> anyhow::Result<i32> 
             r.wall_s,
             r.sim_s / r.wall_s.max(1e-9)
         );
-        let turns: Vec<String> = r.turns.iter().map(|(p, s)| format!("{p} {:.1} ms", s * 1e3)).collect();
-        println!("turns: {}", turns.join(", "));
+        println!("{}", super::inproc::turns_line(&r.turns));
         if r.left_out > 0 {
             println!("left out: {} messages stamped after the tick they came in", r.left_out);
         }

@@ -46,7 +46,6 @@ fn run_in_process(file: &Path, opts: &LaunchArgs) -> anyhow::Result<(harvey_supe
         ran.wall_s,
         ran.sim_s / ran.wall_s.max(1e-9)
     );
-    let turns: Vec<String> = ran.turns.iter().map(|(n, s)| format!("{n} {:.0} ms", s * 1e3)).collect();
-    println!("turns: {}", turns.join(", "));
+    println!("{}", inproc::turns_line(&ran.turns));
     Ok((ran.outcome, run_dir))
 }

@@ -69,6 +69,12 @@ impl Inputs {
     }
 }
 
+/// Each clock party's share of the wall time, as printed: `name N ms, ...`.
+pub fn turns_line(turns: &[(String, f64)]) -> String {
+    let turns: Vec<String> = turns.iter().map(|(p, s)| format!("{p} {:.1} ms", s * 1e3)).collect();
+    format!("turns: {}", turns.join(", "))
+}
+
 /// What a replay in process did.
 pub struct Replayed {
     pub ticks: u64,
