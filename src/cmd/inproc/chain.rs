@@ -112,8 +112,7 @@ impl Chain {
                 Party::Master => continue,
                 Party::Recorder => self.sink.record_tick(tick)?,
                 Party::Node(n) if !n.finished() => {
-                    let name = n.name().to_owned();
-                    n.step(tick).with_context(|| format!("service {name}, tick at {tick} ns"))?
+                    n.step(tick).with_context(|| format!("service {}, tick at {tick} ns", n.name()))?
                 }
                 Party::Node(_) => {}
             }

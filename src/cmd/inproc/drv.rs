@@ -7,7 +7,7 @@
 use clap::Parser;
 use harvey_denning_bridge::BridgeState;
 use harvey_denning_bridge::link::{BridgePorts, Link, receive, sync};
-use harvey_drv_protocol::Decoder;
+use harvey_drv_protocol::{Decoder, Line};
 use harvey_msgs::{EncodersRaw, LogLine, MissionStatus, MotionCommand, SonarRaw, TruePose, topics};
 use harvey_runtime::Rosout;
 use harvey_runtime::node::memory::{Hub, Receiver, Sender};
@@ -76,6 +76,8 @@ pub struct Drv<'a> {
     bridge_decoder: Decoder,
     batch: Vec<MotionCommand>,
     round: Vec<String>,
+    /// The host's frames the DRV decoded this round.
+    lines: Vec<Line>,
 }
 
 /// Service `own`'s arguments as its executable parses them.
@@ -127,6 +129,7 @@ impl<'a> Drv<'a> {
             bridge_decoder: Decoder::new(),
             batch: Vec::new(),
             round: Vec::new(),
+            lines: Vec::new(),
         })
     }
 
@@ -146,13 +149,13 @@ impl<'a> Drv<'a> {
         link.rosout.pause();
 
         // The simulated DRV reads the line (its logs are not the run's, as in its own process).
-        let mut lines = Vec::new();
+        let lines = &mut self.lines;
         self.sim_decoder.push(&link.port, |frame| match frame {
             Ok(l) => lines.push(l),
             Err(e) => tracing::warn!("the simulated DRV: bad frame from the host: {e}"),
         });
         link.port.clear();
-        for l in lines {
+        for l in self.lines.drain(..) {
             self.sim.on_line(&mut self.from_drv, l, true)?;
         }
 
