@@ -1,6 +1,7 @@
 //! The conventions the build enforces: every Rust file opens with a `//!` line saying what it
 //! is; only `crates/bus` uses iceoryx2 (the zero-copy marker aside); only the recording crate
-//! and the recorder draw with rerun; only the Foxglove bridge serves with foxglove; no service
+//! and the recorder draw with rerun; only the Foxglove bridge serves with foxglove, only the Zenoh
+//! bridge speaks zenoh; no service
 //! crate depends on another service crate and no `crates/*` on a `services/*`, read from
 //! `cargo metadata`. Each rule is a function over plain data, tested on a deliberate violation
 //! as well as on the workspace itself.
@@ -108,7 +109,7 @@ fn dependency_violations(packages: &[Package]) -> Vec<String> {
 
 /// Which packages may name a dependency: iceoryx2 only in the bus (its marker trait and derive
 /// also in the wire types and the pose they carry), rerun only where runs are drawn, foxglove
-/// (a WebSocket server) only in the Foxglove bridge.
+/// (a WebSocket server) only in the Foxglove bridge, zenoh only in the Zenoh bridge.
 fn confinement_violations(packages: &[Package]) -> Vec<String> {
     let allowed = |dep: &str| -> Option<&'static [&'static str]> {
         match dep {
@@ -118,6 +119,7 @@ fn confinement_violations(packages: &[Package]) -> Vec<String> {
             }
             "rerun" => Some(&["crates/recording", "services/recorder"]),
             "foxglove" => Some(&["services/foxglove-bridge"]),
+            "zenoh" => Some(&["services/zenoh-bridge"]),
             _ => None,
         }
     };
@@ -210,13 +212,17 @@ fn each_rule_catches_a_deliberate_violation() {
     cli.deps.push(dep("harvey-recorder", "services/recorder", false));
     cli.deps.push(Dep { name: "rerun".into(), dir: None, dev: false });
     cli.deps.push(Dep { name: "foxglove".into(), dir: None, dev: false });
+    cli.deps.push(Dep { name: "zenoh".into(), dir: None, dev: false });
     let v = dependency_violations(&packages);
     assert_eq!(v.len(), 3, "{v:#?}");
     assert!(v.iter().any(|m| m.starts_with("service harvey-ums") && m.contains("harvey-sim-drv")), "{v:#?}");
     assert!(v.iter().any(|m| m.contains("crate harvey-vision") && m.contains("harvey-camera")), "{v:#?}");
     assert!(v.iter().any(|m| m.contains("the CLI") && m.contains("harvey-recorder")), "{v:#?}");
     let c = confinement_violations(&packages);
-    assert!(c.len() == 2 && c[0].contains("rerun") && c[1].contains("foxglove"), "{c:#?}");
+    assert!(
+        c.len() == 3 && c[0].contains("rerun") && c[1].contains("foxglove") && c[2].contains("zenoh"),
+        "{c:#?}"
+    );
     assert!(header_violation("x.rs", "use std::fs;\n").is_some());
     assert!(header_violation("x.rs", "//! What x is.\nuse std::fs;\n").is_none());
     let direct = ["let n = iceoryx2", "::node::NodeBuilder::new();\n"].concat();

@@ -14,6 +14,7 @@ mod replay_launch;
 pub mod run;
 pub mod sweep;
 pub mod topic;
+mod zenoh;
 
 use std::path::{Path, PathBuf};
 
@@ -40,6 +41,20 @@ pub struct LaunchArgs {
     /// 127.0.0.1:8765). Give it as `--foxglove=ADDR` before a mission's path.
     #[arg(long, num_args = 0..=1, default_missing_value = live::FOXGLOVE_DEFAULT, value_name = "ADDR")]
     pub foxglove: Option<String>,
+    /// Also export every topic on Zenoh (`docs/zenoh.md`): the Zenoh bridge runs as one more
+    /// service, listening at ENDPOINT (`tcp/HOST:PORT`; repeatable) for peers on other hosts.
+    #[arg(long, value_name = "ENDPOINT")]
+    pub zenoh_listen: Vec<String>,
+    /// Like `--zenoh-listen`, but the bridge connects to a peer listening at ENDPOINT.
+    #[arg(long, value_name = "ENDPOINT")]
+    pub zenoh_connect: Vec<String>,
+}
+
+impl LaunchArgs {
+    /// Whether the launch gets a Zenoh bridge.
+    pub fn zenoh(&self) -> bool {
+        !self.zenoh_listen.is_empty() || !self.zenoh_connect.is_empty()
+    }
 }
 
 /// Where launch file `lf` runs, given `args`.
@@ -68,6 +83,13 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
             if at.port() == 0 { format!("ws://{}:<a free port>", at.ip()) } else { format!("ws://{at}") };
         println!("foxglove: serving at {url} (Foxglove: Open connection, Foxglove WebSocket)");
     }
+    if args.zenoh() {
+        zenoh::check_endpoints(&args.zenoh_listen, &args.zenoh_connect)?;
+        println!(
+            "zenoh: every topic exported (listen {:?}, connect {:?})",
+            args.zenoh_listen, args.zenoh_connect
+        );
+    }
     tracing::info!(launch = %lf.settings.name, run_dir = %opts.run_dir.display(), prefix = %opts.prefix, "launching {} services", lf.services.len());
     let exe = std::env::current_exe()?;
     let make = || {
@@ -78,6 +100,12 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
         }
         if let Some(addr) = &args.foxglove {
             cmd.arg(format!("--foxglove={addr}"));
+        }
+        for e in &args.zenoh_listen {
+            cmd.args(["--zenoh-listen", e]);
+        }
+        for e in &args.zenoh_connect {
+            cmd.args(["--zenoh-connect", e]);
         }
         cmd
     };

@@ -133,6 +133,8 @@ mod tests {
             realtime: false,
             live: None,
             foxglove: None,
+            zenoh_listen: Vec::new(),
+            zenoh_connect: Vec::new(),
         };
         let how = How { check: false, rrd: false, trust: false, in_process: false };
         assert!(run(&recording, how, opts).is_err(), "a bad prefix is refused");

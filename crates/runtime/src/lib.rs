@@ -1,6 +1,7 @@
 //! What every Harvey service process shares: logging set-up, the readiness handshake with
 //! the supervisor, [`checkpoint`]s of a service's state across restarts, and its warnings on
-//! `rosout` ([`rosout`]), repeated ones said once a period ([`throttle`]).
+//! `rosout` ([`rosout`]), repeated ones said once a period ([`throttle`]), and the bridges' taps
+//! on every topic ([`taps`]).
 //!
 //! Readiness: the supervisor passes a pipe's write end in `$HARVEY_READY_FD`; a service calls
 //! [`notify_ready`] once its ports exist, which writes `READY\n` and closes the pipe. A service
@@ -11,6 +12,7 @@ pub mod journal;
 pub mod node;
 pub mod resume;
 pub mod rosout;
+pub mod taps;
 pub mod throttle;
 
 pub use checkpoint::{Checkpoint, CheckpointError, STATE_DIR_ENV};

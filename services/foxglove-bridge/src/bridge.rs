@@ -11,7 +11,7 @@ use harvey_cdr::Def;
 
 use crate::derive::Latched;
 use crate::derive::{Derive, Derived};
-use crate::taps::{Tap, schema_of};
+use harvey_runtime::taps::{Tap, schema_of};
 
 /// A raw channel of `cdr` messages of `def`, on `topic` (with its leading `/`).
 pub fn channel(topic: &str, def: &Def) -> anyhow::Result<Arc<RawChannel>> {
@@ -160,10 +160,10 @@ mod tests {
 
     /// A test's own bus domain (its prefix, to retire), the bridge's taps on it, and the
     /// latched store.
-    fn domain(tag: &str) -> (String, Bus, Vec<Box<dyn crate::taps::Tap>>, Arc<Latched>) {
+    fn domain(tag: &str) -> (String, Bus, Vec<Box<dyn harvey_runtime::taps::Tap>>, Arc<Latched>) {
         let prefix = format!("{tag}{}_", std::process::id());
         let bus = Bus::join_with_prefix("foxglove-bridge-test", &prefix).expect("bus");
-        let taps = crate::taps::open_all(&bus).expect("taps");
+        let taps = harvey_runtime::taps::open_all(&bus).expect("taps");
         (prefix, bus, taps, Arc::new(Latched::default()))
     }
 

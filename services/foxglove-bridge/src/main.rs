@@ -16,7 +16,6 @@ use harvey_bus::{Bus, Waiter, Wake};
 
 mod bridge;
 mod derive;
-mod taps;
 
 /// Where the bridge listens unless told otherwise: Foxglove's own default.
 const DEFAULT_LISTEN: &str = "127.0.0.1:8765";
@@ -59,7 +58,7 @@ fn main() -> anyhow::Result<()> {
         None => None,
     };
     let bus = Bus::join("foxglove-bridge")?;
-    let taps = taps::open_all(&bus)?;
+    let taps = harvey_runtime::taps::open_all(&bus)?;
     // Channels are advertised to every client that connects from now on.
     let latched = std::sync::Arc::new(derive::Latched::default());
     let mut bridge = bridge::Bridge::new(&taps, derive::hook(world.as_ref()), latched.clone())?;

@@ -1,7 +1,7 @@
-//! The bridge's taps: one subscription per Harvey topic, opened as an observer (not a party of
-//! the clock chain), each message handed over in CDR exactly as the recorder writes it
-//! (`harvey_cdr::encode`, `encode_image`) with its `ros2msg` schema (`harvey_cdr::full_text`),
-//! when asked for: a camera frame's header comes with it either way, read in place.
+//! Taps on every topic for the bridges (Foxglove, Zenoh): one subscription per Harvey topic,
+//! each message handed over in CDR exactly as the recorder writes it (`harvey_cdr::encode`,
+//! `encode_image`) with its `ros2msg` schema (`harvey_cdr::full_text`), when asked for: a camera
+//! frame's header comes with it either way, read in place.
 
 use harvey_bus::{Bus, FrameSubscriber, Subscriber, Waitable};
 use harvey_cdr::{Def, Ros2Msg, encode, encode_image, full_text, image_def};
@@ -9,6 +9,8 @@ use harvey_msgs::{FrameHeader, Message, Qos, Topic, topics};
 
 /// One message taken from a topic.
 pub struct Taken<'a> {
+    /// The publisher's sequence number (a frame's too, which its CDR has no field for).
+    pub seq: u64,
     pub stamp_ns: u64,
     /// The message in CDR; empty when the caller did not ask for it.
     pub cdr: &'a [u8],
@@ -58,7 +60,7 @@ impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
                 *buf = encode(m, std::mem::take(buf));
             }
             let cdr = if want { buf.as_slice() } else { &[] };
-            f(Taken { stamp_ns: h.stamp_ns, cdr, frame: None });
+            f(Taken { seq: h.seq, stamp_ns: h.stamp_ns, cdr, frame: None });
         })?)
     }
 }
@@ -94,7 +96,7 @@ impl Tap for FrameTap {
             // The slot goes back to the camera before the frame is sent on.
             drop(frame);
             let cdr = if want { buf.as_slice() } else { &[] };
-            f(Taken { stamp_ns: h.stamp_ns, cdr, frame: Some((h, pixel_bytes)) });
+            f(Taken { seq: h.seq, stamp_ns: h.stamp_ns, cdr, frame: Some((h, pixel_bytes)) });
             n += 1;
         }
         Ok(n)
@@ -107,6 +109,11 @@ fn tap<T: Message + Ros2Msg>(bus: &Bus, topic: Topic<T>) -> anyhow::Result<Box<d
 
 /// Subscribes to every topic of [`topics::ALL`], in that order. Fails if one is missing here.
 pub fn open_all(bus: &Bus) -> anyhow::Result<Vec<Box<dyn Tap>>> {
+    open(bus, |_| true)
+}
+
+/// Subscribes to the topics of [`topics::ALL`] that `wanted` picks, in that order.
+pub fn open(bus: &Bus, wanted: impl Fn(&str) -> bool) -> anyhow::Result<Vec<Box<dyn Tap>>> {
     let taps: Vec<Box<dyn Tap>> = vec![
         tap(bus, topics::SIM_TRUTH)?,
         tap(bus, topics::DRV_SONAR_RAW)?,
@@ -131,8 +138,8 @@ pub fn open_all(bus: &Bus) -> anyhow::Result<Vec<Box<dyn Tap>>> {
     ];
     let tapped: Vec<&str> = taps.iter().map(|t| t.topic()).collect();
     let missing: Vec<&&str> = topics::ALL.iter().filter(|t| !tapped.contains(t)).collect();
-    anyhow::ensure!(missing.is_empty(), "the Foxglove bridge has no tap for {missing:?}");
-    Ok(taps)
+    anyhow::ensure!(missing.is_empty(), "the bridges have no tap for {missing:?}");
+    Ok(taps.into_iter().filter(|t| wanted(t.topic())).collect())
 }
 
 #[cfg(test)]
@@ -142,8 +149,8 @@ mod tests {
 
     #[test]
     fn every_topic_is_tapped_with_a_schema_its_messages_decode_by() {
-        let prefix = format!("tfoxtaps{}_", std::process::id());
-        let bus = Bus::join_with_prefix("foxglove-bridge-test", &prefix).expect("bus");
+        let prefix = format!("trttaps{}_", std::process::id());
+        let bus = Bus::join_with_prefix("taps-test", &prefix).expect("bus");
         let taps = open_all(&bus).expect("taps");
         let names: Vec<&str> = taps.iter().map(|t| t.topic()).collect();
         assert_eq!(names, topics::ALL);
@@ -158,14 +165,18 @@ mod tests {
         odometry.send(&sent).expect("send");
         let tap = taps.iter().find(|t| t.topic() == topics::ODOMETRY.name).expect("odometry tap");
         let (mut buf, mut got) = (Vec::new(), Vec::new());
-        let n = tap.take(true, &mut buf, &mut |m| got.push((m.stamp_ns, m.cdr.to_vec()))).expect("take");
+        let n =
+            tap.take(true, &mut buf, &mut |m| got.push((m.seq, m.stamp_ns, m.cdr.to_vec()))).expect("take");
         assert_eq!(n, 1);
-        assert_eq!(got[0].0, 350_000_000);
-        assert_eq!(got[0].1, encode(&sent, Vec::new()), "the recorder's bytes");
+        assert_eq!((got[0].0, got[0].1), (7, 350_000_000));
+        assert_eq!(got[0].2, encode(&sent, Vec::new()), "the recorder's bytes");
         odometry.send(&sent).expect("send");
         let n = tap.take(false, &mut buf, &mut |m| assert!(m.cdr.is_empty())).expect("take");
         assert_eq!(n, 1, "taken, not encoded");
-        drop((odometry, taps, bus));
+        let some = open(&bus, |t| t.starts_with("vision/")).expect("some taps");
+        let names: Vec<&str> = some.iter().map(|t| t.topic()).collect();
+        assert_eq!(names, ["vision/detections", "vision/sightings", "vision/requests", "vision/results"]);
+        drop((odometry, taps, some, bus));
         harvey_bus::retire_domain(&prefix).expect("retire");
     }
 }

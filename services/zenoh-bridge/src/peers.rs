@@ -1,0 +1,66 @@
+//! The other hosts as the liveliness tokens show them: before an importing bridge says it is
+//! ready, every topic it imports must be exported by some host, or it gives up naming the
+//! topics nobody exports (a host that never joined, a wrong endpoint) instead of hanging.
+
+use std::collections::BTreeSet;
+use std::time::{Duration, Instant};
+
+use zenoh::Wait;
+
+use crate::wire;
+
+/// `(layout, host, topic)` of every liveliness token live in `namespace` now.
+fn live_tokens(session: &zenoh::Session, namespace: &str) -> anyhow::Result<Vec<(String, String, String)>> {
+    let key = wire::live_all(namespace);
+    let replies = session
+        .liveliness()
+        .get(key.clone())
+        .timeout(Duration::from_millis(500))
+        .wait()
+        .map_err(|e| anyhow::anyhow!("asking Zenoh for {key}: {e}"))?;
+    let mut out = Vec::new();
+    while let Ok(reply) = replies.recv() {
+        if let Ok(sample) = reply.result()
+            && let Some((layout, host, topic)) = wire::parse_live_key(namespace, sample.key_expr().as_str())
+        {
+            out.push((layout.to_owned(), host.to_owned(), topic.to_owned()));
+        }
+    }
+    Ok(out)
+}
+
+/// Waits until a host of this layout exports each of `topics`, at most `wait`.
+pub fn await_exporters(
+    session: &zenoh::Session,
+    namespace: &str,
+    topics: &[String],
+    wait: Duration,
+) -> anyhow::Result<()> {
+    let start = Instant::now();
+    let layout = wire::LAYOUT.to_string();
+    loop {
+        let tokens = live_tokens(session, namespace)?;
+        let other: BTreeSet<String> =
+            tokens.iter().filter(|(l, ..)| *l != layout).map(|(l, h, _)| format!("{h} (v{l})")).collect();
+        if !other.is_empty() {
+            anyhow::bail!(
+                "hosts {other:?} speak another key layout than this Harvey's v{layout}: another Harvey version"
+            );
+        }
+        let missing: Vec<&String> =
+            topics.iter().filter(|t| !tokens.iter().any(|(_, _, x)| x == *t)).collect();
+        if missing.is_empty() {
+            for (_, host, topic) in tokens.iter().filter(|(.., t)| topics.contains(t)) {
+                tracing::info!(topic, host, "importing");
+            }
+            return Ok(());
+        }
+        if start.elapsed() >= wait {
+            anyhow::bail!(
+                "no host exports {missing:?} after {} s: is the other host's bridge running, with --zenoh-connect or --zenoh-listen pointing here?",
+                wait.as_secs()
+            );
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}

@@ -1,0 +1,100 @@
+//! The bridge's Zenoh session: a peer that listens on and connects to exactly the endpoints it
+//! is given, with multicast scouting and gossip off, so that nothing is opened unless asked and
+//! no other host is found unless named.
+
+use zenoh::{Config, Session, Wait};
+
+/// Where the session listens and whom it connects to.
+#[derive(Debug, Clone, Default)]
+pub struct Endpoints {
+    pub listen: Vec<String>,
+    pub connect: Vec<String>,
+}
+
+/// A Zenoh locator Harvey accepts: `tcp/HOST:PORT` (the only transport this build carries).
+pub fn check_endpoint(flag: &str, endpoint: &str) -> anyhow::Result<()> {
+    let Some(addr) = endpoint.strip_prefix("tcp/") else {
+        anyhow::bail!("{flag} {endpoint}: not `tcp/HOST:PORT` (this build speaks Zenoh over TCP only)");
+    };
+    let addr = addr.split('#').next().unwrap_or(addr);
+    let port_ok =
+        addr.rsplit_once(':').is_some_and(|(host, port)| !host.is_empty() && port.parse::<u16>().is_ok());
+    anyhow::ensure!(port_ok, "{flag} {endpoint}: not `tcp/HOST:PORT`");
+    Ok(())
+}
+
+/// The session's configuration: peer mode, scouting off, the endpoints given, failing at once
+/// when a listening endpoint cannot be bound.
+pub fn config(ends: &Endpoints) -> anyhow::Result<Config> {
+    for e in &ends.listen {
+        check_endpoint("--zenoh-listen", e)?;
+    }
+    for e in &ends.connect {
+        check_endpoint("--zenoh-connect", e)?;
+    }
+    let mut c = Config::default();
+    let json = |v: &[String]| {
+        let quoted: Vec<String> = v.iter().map(|e| format!("\"{}\"", e.replace('"', ""))).collect();
+        format!("[{}]", quoted.join(","))
+    };
+    let settings = [
+        ("mode", "\"peer\"".to_owned()),
+        ("scouting/multicast/enabled", "false".to_owned()),
+        ("scouting/gossip/enabled", "false".to_owned()),
+        // No admin space, no timestamps: nothing but what the bridge declares.
+        ("adminspace/enabled", "false".to_owned()),
+        ("listen/endpoints", json(&ends.listen)),
+        ("listen/exit_on_failure", "true".to_owned()),
+        ("connect/endpoints", json(&ends.connect)),
+        // A peer that is not up yet is retried; the session opens regardless, and the bridge
+        // waits for the topics it imports, naming them.
+        ("connect/exit_on_failure", "false".to_owned()),
+    ];
+    for (key, value) in settings {
+        c.insert_json5(key, &value).map_err(|e| anyhow::anyhow!("Zenoh setting {key} = {value}: {e}"))?;
+    }
+    Ok(c)
+}
+
+/// Opens the session; an endpoint that cannot be bound is an error naming it.
+pub fn open(ends: &Endpoints) -> anyhow::Result<Session> {
+    anyhow::ensure!(
+        !ends.listen.is_empty() || !ends.connect.is_empty(),
+        "no Zenoh endpoint: give --zenoh-listen tcp/HOST:PORT or --zenoh-connect tcp/HOST:PORT"
+    );
+    let c = config(ends)?;
+    zenoh::open(c).wait().map_err(|e| {
+        anyhow::anyhow!(
+            "cannot open the Zenoh session (listen {:?}, connect {:?}): {e}",
+            ends.listen,
+            ends.connect
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn endpoints_are_tcp_host_port() {
+        assert!(check_endpoint("--zenoh-listen", "tcp/127.0.0.1:7447").is_ok());
+        assert!(check_endpoint("--zenoh-listen", "tcp/[::1]:7447").is_ok());
+        let e = check_endpoint("--zenoh-listen", "udp/127.0.0.1:7447").expect_err("udp").to_string();
+        assert!(e.contains("--zenoh-listen udp/127.0.0.1:7447") && e.contains("TCP only"), "{e}");
+        assert!(check_endpoint("--zenoh-connect", "tcp/127.0.0.1").is_err());
+        assert!(check_endpoint("--zenoh-connect", "tcp/:7447").is_err());
+        let e = open(&Endpoints::default()).expect_err("nothing").to_string();
+        assert!(e.contains("no Zenoh endpoint"), "{e}");
+    }
+
+    #[test]
+    fn a_port_in_use_is_named() {
+        let taken = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
+        let port = taken.local_addr().expect("addr").port();
+        let ends = Endpoints { listen: vec![format!("tcp/127.0.0.1:{port}")], connect: vec![] };
+        let Err(e) = open(&ends) else { panic!("port {port} is in use: the session must not open") };
+        let e = e.to_string();
+        assert!(e.contains(&format!("tcp/127.0.0.1:{port}")), "{e}");
+    }
+}
