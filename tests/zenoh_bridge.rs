@@ -129,3 +129,70 @@ fn an_import_nobody_exports_and_a_bad_endpoint_are_named() {
     assert!(err.contains("--zenoh-listen udp/127.0.0.1:7447: not `tcp/HOST:PORT`"), "{err}");
     harvey_bus::retire_domain(&prefix).expect("retire");
 }
+
+/// `harvey diff`'s verdict on two recordings.
+fn diff(a: &std::path::Path, b: &std::path::Path) -> String {
+    let out = common::harvey(&["diff", a.to_str().expect("utf8"), b.to_str().expect("utf8")])
+        .output()
+        .expect("diff");
+    String::from_utf8_lossy(&out.stdout).into_owned()
+}
+
+#[test]
+fn a_mission_split_over_two_hosts_records_what_it_records_on_one() {
+    let mission = "missions/default-split.toml";
+    let (pa, pb) = (common::unique_prefix("zsa"), common::unique_prefix("zsb"));
+    let (main_dir, gpu_dir) = (common::scratch("zenoh-split-main"), common::scratch("zenoh-split-gpu"));
+    let at = format!("tcp/127.0.0.1:{}", free_port());
+    let mut gpu =
+        common::harvey(&["launch", mission, "--host", "gpu", "--prefix", &pb, "--zenoh-listen", &at])
+            .args(["--run-dir", gpu_dir.to_str().expect("utf8")])
+            .stdout(Stdio::null())
+            .spawn()
+            .expect("the gpu host's share");
+    let main = common::harvey(&["run", mission, "--host", "main", "--prefix", &pa, "--zenoh-connect", &at])
+        .args(["--run-dir", main_dir.to_str().expect("utf8")])
+        .output()
+        .expect("the main host's share");
+    let stdout = String::from_utf8_lossy(&main.stdout);
+    assert!(main.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&main.stderr));
+    assert!(stdout.contains("goal reached"), "{stdout}");
+    // The main host's bridge ends the launch on the other host too.
+    assert!(
+        common::wait_exit(&mut gpu, Duration::from_secs(60)).success(),
+        "the gpu host's launch ends cleanly"
+    );
+
+    let one = common::run_mission(mission, "zenoh-split-one");
+    assert!(one.status.success(), "{}", one.stdout);
+    let verdict = diff(&one.dir.join("run.mcap"), &main_dir.join("run.mcap"));
+    assert!(verdict.starts_with("identical"), "split over two hosts against one host: {verdict}");
+    for p in [&pa, &pb] {
+        assert_eq!(common::shm_leftovers(p), Vec::<String>::new());
+    }
+    for d in [&main_dir, &gpu_dir] {
+        std::fs::remove_dir_all(d).ok();
+    }
+}
+
+#[test]
+fn a_host_that_never_joins_is_named() {
+    let dir = common::scratch("zenoh-split-alone");
+    let prefix = common::unique_prefix("zsn");
+    let at = format!("tcp/127.0.0.1:{}", free_port());
+    let out = common::harvey(&["run", "missions/default-split.toml", "--host", "main", "--prefix", &prefix])
+        .args(["--zenoh-listen", &at, "--run-dir", dir.to_str().expect("utf8")])
+        .output()
+        .expect("runs");
+    let all = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert!(!out.status.success(), "{all}");
+    assert!(all.contains("host gpu never joined"), "{all}");
+    let unknown =
+        common::harvey(&["launch", "missions/default-split.toml", "--host", "tpu", "--zenoh-listen", &at])
+            .output()
+            .expect("runs");
+    let err = String::from_utf8_lossy(&unknown.stderr);
+    assert!(!unknown.status.success() && err.contains("none on `tpu`"), "{err}");
+    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -25,7 +25,9 @@ pub fn supervise(file: &Path, args: &LaunchArgs) -> anyhow::Result<i32> {
         // First: it is listening before anything publishes, and is stopped last.
         lf.services.insert(0, super::live::foxglove_service(addr, lf.settings.world.is_some())?);
     }
-    if args.zenoh() {
+    if let Some(host) = &args.host {
+        super::hosts::place(&mut lf, host, &args.zenoh_listen, &args.zenoh_connect)?;
+    } else if args.zenoh() {
         // First, as the Foxglove bridge: its peers connect before anything publishes. In a
         // deterministic launch it is the party before the recorder (the chain wraps round).
         lf.services.insert(0, super::zenoh::zenoh_service(&args.zenoh_listen, &args.zenoh_connect)?);

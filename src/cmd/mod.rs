@@ -4,6 +4,7 @@
 pub mod chaos;
 pub mod diff;
 pub mod export;
+mod hosts;
 pub mod info;
 mod inproc;
 pub mod launch;
@@ -48,6 +49,11 @@ pub struct LaunchArgs {
     /// Like `--zenoh-listen`, but the bridge connects to a peer listening at ENDPOINT.
     #[arg(long, value_name = "ENDPOINT")]
     pub zenoh_connect: Vec<String>,
+    /// Run only this host's share of a launch split over hosts (`host = "NAME"` on its
+    /// services; unplaced ones are `main`'s), joined to the other host's over Zenoh at
+    /// `--zenoh-listen`/`--zenoh-connect` (`docs/zenoh.md`).
+    #[arg(long, value_name = "NAME")]
+    pub host: Option<String>,
 }
 
 impl LaunchArgs {
@@ -83,7 +89,15 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
             if at.port() == 0 { format!("ws://{}:<a free port>", at.ip()) } else { format!("ws://{at}") };
         println!("foxglove: serving at {url} (Foxglove: Open connection, Foxglove WebSocket)");
     }
-    if args.zenoh() {
+    if let Some(host) = &args.host {
+        // Checked here too, so that a bad placement is said before anything starts.
+        hosts::place(&mut lf.clone(), host, &args.zenoh_listen, &args.zenoh_connect)?;
+        zenoh::check_endpoints(&args.zenoh_listen, &args.zenoh_connect)?;
+        println!(
+            "zenoh: host {host}'s share (listen {:?}, connect {:?})",
+            args.zenoh_listen, args.zenoh_connect
+        );
+    } else if args.zenoh() {
         zenoh::check_endpoints(&args.zenoh_listen, &args.zenoh_connect)?;
         println!(
             "zenoh: every topic exported (listen {:?}, connect {:?})",
@@ -106,6 +120,9 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
         }
         for e in &args.zenoh_connect {
             cmd.args(["--zenoh-connect", e]);
+        }
+        if let Some(host) = &args.host {
+            cmd.args(["--host", host]);
         }
         cmd
     };

@@ -135,6 +135,7 @@ mod tests {
             foxglove: None,
             zenoh_listen: Vec::new(),
             zenoh_connect: Vec::new(),
+            host: None,
         };
         let how = How { check: false, rrd: false, trust: false, in_process: false };
         assert!(run(&recording, how, opts).is_err(), "a bad prefix is refused");

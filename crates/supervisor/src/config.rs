@@ -90,6 +90,9 @@ fn default_backoff_max_ms() -> u64 {
     2000
 }
 
+/// The host of the services a launch file does not place.
+pub const MAIN_HOST: &str = "main";
+
 /// One `[[service]]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -116,6 +119,11 @@ pub struct Service {
     /// service on the far side of a serial line, like the simulated DRV).
     #[serde(default = "default_true")]
     pub clock_party: bool,
+    /// The host this service runs on when the launch is split over hosts (`harvey launch FILE
+    /// --host NAME`, `docs/zenoh.md`); unplaced services run on the main host, `main`. A launch
+    /// run on one host runs every service whatever its host.
+    #[serde(default)]
+    pub host: Option<Spanned<String>>,
 }
 
 fn default_true() -> bool {
@@ -125,6 +133,11 @@ fn default_true() -> bool {
 impl Service {
     pub fn name(&self) -> &str {
         self.name.get_ref()
+    }
+
+    /// The host this service is placed on (`main` unless it says otherwise).
+    pub fn host(&self) -> &str {
+        self.host.as_ref().map_or(MAIN_HOST, |h| h.get_ref().as_str())
     }
 
     pub fn binary_name(&self) -> String {

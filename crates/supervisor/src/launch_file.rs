@@ -144,6 +144,18 @@ impl LaunchFile {
                 ));
             }
         }
+        for (i, s) in parsed.services.iter().enumerate() {
+            let Some(host) = &s.host else { continue };
+            let h = host.get_ref();
+            if h.is_empty() || !h.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+                return Err(at(
+                    host.span().start,
+                    format!(
+                        "key `service[{i}].host`: `{h}`: a host's name takes letters, digits, `-` and `_`"
+                    ),
+                ));
+            }
+        }
         for f in &parsed.launch.files {
             if !is_plain_relative(f.get_ref()) {
                 return Err(at(

@@ -12,10 +12,14 @@ use harvey_bus::{Bus, FdSource, Pace, Step, Waitable, Waiter};
 use harvey_msgs::topics;
 use zenoh::Wait;
 
+mod bundle;
+mod chain;
 mod export;
 mod import;
+mod mailbox;
 mod peers;
 mod session;
+mod sinks;
 mod wire;
 
 /// How often the counts are logged.
@@ -45,9 +49,25 @@ struct Args {
     /// The largest camera frame taken from Zenoh (default: 1920x1080 rgb8).
     #[arg(long, default_value_t = 1920 * 1080 * 3)]
     max_frame_bytes: usize,
-    /// How long to wait for a host exporting each imported topic before giving up, naming them.
+    /// How long to wait for a host exporting each imported topic (or for the other host of a
+    /// chain) before giving up, naming them.
     #[arg(long, default_value_t = 30)]
     wait_s: u64,
+    /// Carry the clock chain to `--peer-host` (a deterministic launch split over two hosts,
+    /// `harvey launch FILE --host NAME`): `stand-in` on the main host, a party in place of the
+    /// other host's services; `segment` on the other host, its clock master. Every topic goes.
+    #[arg(long, value_enum, requires = "peer_host", conflicts_with_all = ["export", "import"])]
+    chain: Option<Role>,
+    /// The other host of the chain.
+    #[arg(long)]
+    peer_host: Option<String>,
+}
+
+/// `--chain`'s values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum Role {
+    StandIn,
+    Segment,
 }
 
 /// `--export`'s topics: `all`, or names each checked.
@@ -85,26 +105,91 @@ fn main() -> anyhow::Result<()> {
     let args = Args::parse();
     check_name("--host", &args.host)?;
     check_name("--namespace", &args.namespace)?;
+    if let Some(peer) = &args.peer_host {
+        check_name("--peer-host", peer)?;
+    }
     let export = exported(&args)?;
     anyhow::ensure!(
-        !export.is_empty() || !args.import.is_empty(),
-        "nothing to carry: give --export or --import"
+        args.chain.is_some() || !export.is_empty() || !args.import.is_empty(),
+        "nothing to carry: give --export, --import or --chain"
     );
     let ends = session::Endpoints { listen: args.listen.clone(), connect: args.connect.clone() };
     let session = session::open(&ends)?;
     let bus = Bus::join("zenoh-bridge")?;
     let pace = Pace::from_env(&bus)?;
+    let mut sinks = sinks::Sinks::new(args.max_frame_bytes);
+    match (args.chain, &args.peer_host) {
+        (Some(role), Some(peer)) => run_chain(&args, role, peer, &session, &bus, &pace, &mut sinks)?,
+        _ => run_topics(&args, &export, &session, &bus, &pace, &mut sinks)?,
+    }
+    session.close().wait().map_err(|e| anyhow::anyhow!("closing the Zenoh session: {e}"))?;
+    Ok(())
+}
+
+/// `--chain`: every topic, tick by tick, between this host and the other.
+fn run_chain(
+    args: &Args,
+    role: Role,
+    peer: &str,
+    session: &zenoh::Session,
+    bus: &Bus,
+    pace: &Pace,
+    sinks: &mut sinks::Sinks,
+) -> anyhow::Result<()> {
+    let Some(lockstep) = pace.lockstep() else {
+        anyhow::bail!(
+            "--chain runs in a deterministic launch, as one of its clock parties (`harvey launch FILE --host NAME`)"
+        );
+    };
+    let taps = harvey_runtime::taps::open_all(bus)?;
+    let mut chain = chain::Chain::new(session, &args.namespace, (&args.host, peer), bus, &taps, sinks)?;
+    tracing::info!(host = args.host, peer, ?role, listen = ?args.listen, connect = ?args.connect, "carrying the clock chain over Zenoh");
+    if role == Role::Segment {
+        harvey_runtime::notify_ready()?;
+        return chain.run_segment(session, &args.namespace, &args.host, lockstep);
+    }
+    chain::await_peer(session, &args.namespace, peer, Duration::from_secs(args.wait_s))?;
+    let waiter = Waiter::new()?;
+    let _attached = pace.attach(&waiter, &[])?;
+    let turn_waiter = Waiter::new()?;
+    let bell = FdSource::new(chain.bell())?;
+    let _bell = turn_waiter.attach(&bell)?;
+    harvey_runtime::notify_ready()?;
+    loop {
+        match pace.next(&waiter, Some(REPORT_EVERY))? {
+            Step::Stop => break,
+            Step::Go(Some(tick)) => {
+                if !chain.stand_in_turn(&turn_waiter, tick)? {
+                    break;
+                }
+            }
+            Step::Go(None) | Step::Idle => {}
+        }
+        pace.done()?;
+    }
+    chain.end()
+}
+
+/// `--export` and `--import`: topics one by one, each on its own key.
+fn run_topics(
+    args: &Args,
+    export: &[String],
+    session: &zenoh::Session,
+    bus: &Bus,
+    pace: &Pace,
+    sinks: &mut sinks::Sinks,
+) -> anyhow::Result<()> {
     anyhow::ensure!(
         pace.lockstep().is_none() || args.import.is_empty(),
-        "importing into a deterministic launch needs the clock chain carried across hosts, which \
-         this bridge does not do yet: run the launch with --realtime, or export only"
+        "importing topics one by one into a deterministic launch would let them in outside the \
+         chain's turns: split a deterministic launch with `harvey launch FILE --host NAME` (--chain), \
+         run it with --realtime, or export only"
     );
-    let taps = harvey_runtime::taps::open(&bus, |t| export.iter().any(|e| e == t))?;
-    let mut exporter = export::Exporter::new(&session, &args.namespace, &args.host, &taps)?;
-    let mut importer =
-        import::Importer::new(&session, &bus, &args.namespace, &args.import, args.max_frame_bytes)?;
+    let taps = harvey_runtime::taps::open(bus, |t| export.iter().any(|e| e == t))?;
+    let mut exporter = export::Exporter::new(session, &args.namespace, &args.host, &taps)?;
+    let mut importer = import::Importer::new(session, bus, sinks, &args.namespace, &args.import)?;
     if !args.import.is_empty() {
-        peers::await_exporters(&session, &args.namespace, &args.import, Duration::from_secs(args.wait_s))?;
+        peers::await_exporters(session, &args.namespace, &args.import, Duration::from_secs(args.wait_s))?;
     }
     let lockstep = pace.lockstep().is_some();
     let waiter = Waiter::new()?;
@@ -131,7 +216,7 @@ fn main() -> anyhow::Result<()> {
             _ => u64::MAX,
         };
         exporter.forward(&taps, until_ns)?;
-        importer.drain()?;
+        importer.drain(bus, sinks)?;
         pace.done()?;
         if reported.elapsed() >= REPORT_EVERY {
             reported = Instant::now();
@@ -148,7 +233,6 @@ fn main() -> anyhow::Result<()> {
     }
     let sent: Vec<(&str, u64)> = exporter.counts().collect();
     tracing::info!(?sent, left_out = exporter.left_out, imported = ?importer.counts(), "Zenoh bridge stopped");
-    session.close().wait().map_err(|e| anyhow::anyhow!("closing the Zenoh session: {e}"))?;
     Ok(())
 }
 

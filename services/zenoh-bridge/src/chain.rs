@@ -1,0 +1,247 @@
+//! The clock chain carried across two hosts (`docs/zenoh.md`). On the main host the bridge is a
+//! party standing in for the other host's services at their place in the chain: at its turn
+//! for tick T it sends everything the main host's services published since its last turn,
+//! closed by T, waits for the other host's share of T, publishes it, and passes the turn on. On
+//! the other host the bridge is the clock master: it publishes what came, starts the tick, waits
+//! for its chain's tail and sends back what its services published. Each direction is one key on
+//! one publisher, so a tick's messages and its progress arrive together and in order; what the
+//! bridge itself just published is taken off its taps and dropped, never sent back.
+
+use std::time::{Duration, Instant};
+
+use harvey_bus::{Bus, FdSource, Lockstep, Waiter, Wake};
+use harvey_runtime::taps::Tap;
+use zenoh::Wait;
+use zenoh::pubsub::Publisher;
+use zenoh::qos::CongestionControl;
+
+use crate::bundle::{self, Kind};
+use crate::mailbox::Mailbox;
+use crate::sinks::Sinks;
+use crate::wire::{self, Meta};
+
+/// How often a wait for the other host is reported.
+const STALL_REPORT: Duration = Duration::from_secs(5);
+
+/// The key from one host's bridge to the other's.
+fn chain_key(namespace: &str, from: &str, to: &str) -> String {
+    format!("{namespace}/@chain/v{}/{from}/{to}", wire::LAYOUT)
+}
+
+/// The liveliness token of a bridge whose chain has started.
+fn ready_key(namespace: &str, host: &str) -> String {
+    format!("{namespace}/@chain/v{}/ready/{host}", wire::LAYOUT)
+}
+
+/// One host's end of the chain between two hosts.
+pub struct Chain<'a> {
+    pub bus: &'a Bus,
+    pub taps: &'a [Box<dyn Tap>],
+    pub sinks: &'a mut Sinks,
+    peer: String,
+    out: Publisher<'static>,
+    inbox: Mailbox,
+    buf: Vec<u8>,
+    /// What this host's services published since the last bundle went out.
+    pending: bundle::Writer,
+}
+
+impl<'a> Chain<'a> {
+    pub fn new(
+        session: &zenoh::Session,
+        namespace: &str,
+        (host, peer): (&str, &str),
+        bus: &'a Bus,
+        taps: &'a [Box<dyn Tap>],
+        sinks: &'a mut Sinks,
+    ) -> anyhow::Result<Self> {
+        let key = chain_key(namespace, host, peer);
+        let out = session
+            .declare_publisher(key.clone())
+            .congestion_control(CongestionControl::Block)
+            .wait()
+            .map_err(|e| anyhow::anyhow!("cannot publish {key} on Zenoh: {e}"))?;
+        let mut inbox = Mailbox::new()?;
+        inbox.subscribe(session, &chain_key(namespace, peer, host))?;
+        Ok(Self {
+            bus,
+            taps,
+            sinks,
+            peer: peer.to_owned(),
+            out,
+            inbox,
+            buf: Vec::new(),
+            pending: bundle::Writer::new(),
+        })
+    }
+
+    /// What rings when the other host's bundle arrives.
+    pub fn bell(&self) -> &std::os::unix::net::UnixStream {
+        self.inbox.bell()
+    }
+
+    /// Sends what is pending and the messages queued on the taps stamped at most `until_ns`,
+    /// closed by `kind`.
+    fn send(&mut self, kind: Kind, until_ns: u64) -> anyhow::Result<()> {
+        self.collect(until_ns)?;
+        let bundle = self.pending.finish(kind);
+        self.out.put(bundle).wait().map_err(|e| anyhow::anyhow!("sending to host {}: {e}", self.peer))
+    }
+
+    /// Adds the messages queued on the taps stamped at most `until_ns` to what is pending.
+    fn collect(&mut self, until_ns: u64) -> anyhow::Result<()> {
+        let (w, mut failed) = (&mut self.pending, None);
+        for tap in self.taps {
+            let fingerprint = wire::fingerprint(tap.def());
+            tap.take(true, &mut self.buf, &mut |m| {
+                if m.stamp_ns <= until_ns && failed.is_none() {
+                    let meta = Meta { seq: m.seq, stamp_ns: m.stamp_ns, fingerprint };
+                    failed = w.push(tap.topic(), &meta, m.cdr).err();
+                }
+            })?;
+        }
+        failed.map_or(Ok(()), Err)
+    }
+
+    /// Waits for the other host's next bundle; `None` if this process is asked to stop first.
+    fn receive(&self, waiter: &Waiter, waiting_for: &str) -> anyhow::Result<Option<Vec<u8>>> {
+        let since = Instant::now();
+        loop {
+            if let Some(a) = self.inbox.next() {
+                return Ok(Some(a.payload));
+            }
+            match waiter.wait(Some(STALL_REPORT))? {
+                Wake::Shutdown => return Ok(None),
+                Wake::Timeout => tracing::warn!(
+                    host = self.peer,
+                    waited_s = since.elapsed().as_secs(),
+                    "waiting for host {} ({waiting_for})",
+                    self.peer
+                ),
+                Wake::Ready => {}
+            }
+        }
+    }
+
+    /// Publishes a bundle's messages on the bus, then drops what the taps took of them. What
+    /// this host's services published before (outside the chain's turns: a standing request
+    /// made at start-up) is kept for the next bundle first.
+    fn publish(&mut self, payload: &[u8]) -> anyhow::Result<Kind> {
+        let (kind, items) =
+            bundle::read(payload).map_err(|e| anyhow::anyhow!("from host {}: {e}", self.peer))?;
+        self.collect(u64::MAX)?;
+        for item in &items {
+            let sink = self.sinks.get(self.bus, item.topic)?;
+            anyhow::ensure!(
+                sink.fingerprint() == item.meta.fingerprint,
+                "host {} sends {} of another message definition ({:08x}, this build's {:08x}): another Harvey version",
+                self.peer,
+                item.topic,
+                item.meta.fingerprint,
+                sink.fingerprint()
+            );
+            sink.publish(&item.meta, item.cdr)
+                .map_err(|e| anyhow::anyhow!("{} from host {}: {e}", item.topic, self.peer))?;
+        }
+        for tap in self.taps {
+            tap.take(false, &mut self.buf, &mut |_| {})?;
+        }
+        Ok(kind)
+    }
+
+    /// The stand-in's turn for `tick`: this host's messages out, the other host's in. False if
+    /// asked to stop while waiting.
+    pub fn stand_in_turn(&mut self, waiter: &Waiter, tick: u64) -> anyhow::Result<bool> {
+        self.send(Kind::Tick(tick), tick)?;
+        let Some(reply) = self.receive(waiter, &format!("its share of tick {:.3} s", tick as f64 / 1e9))?
+        else {
+            return Ok(false);
+        };
+        match self.publish(&reply)? {
+            Kind::Tick(t) if t == tick => Ok(true),
+            other => anyhow::bail!("host {} answered tick {tick} with {other:?}", self.peer),
+        }
+    }
+
+    /// Tells the other host the launch is ending.
+    pub fn end(&mut self) -> anyhow::Result<()> {
+        self.send(Kind::End, 0)
+    }
+
+    /// The other host's clock master: until the main host ends the launch (or this process is
+    /// stopped), each tick that comes is published, run through this host's chain and answered.
+    pub fn run_segment(
+        &mut self,
+        session: &zenoh::Session,
+        namespace: &str,
+        host: &str,
+        lockstep: &Lockstep,
+    ) -> anyhow::Result<()> {
+        let waiter = Waiter::new()?;
+        let bell = FdSource::new(self.inbox.bell())?;
+        let _a = (waiter.attach(lockstep.predecessor())?, waiter.attach(&bell)?);
+        // The supervisor starts the chain once every service here is ready (tick 0 of the tail).
+        let mut done: Option<u64> = None;
+        while done.is_none() {
+            if waiter.wait(Some(STALL_REPORT))? == Wake::Shutdown {
+                return Ok(());
+            }
+            lockstep.finished(|t| done = Some(t))?;
+        }
+        let _ready = session
+            .liveliness()
+            .declare_token(ready_key(namespace, host))
+            .wait()
+            .map_err(|e| anyhow::anyhow!("declaring this host ready on Zenoh: {e}"))?;
+        loop {
+            let Some(payload) = self.receive(&waiter, "the next tick")? else { return Ok(()) };
+            let tick = match self.publish(&payload)? {
+                Kind::End => return Ok(()),
+                Kind::Tick(t) => t,
+            };
+            lockstep.finish(tick)?;
+            let since = Instant::now();
+            while done.is_none_or(|d| d < tick) {
+                match waiter.wait(Some(STALL_REPORT))? {
+                    Wake::Shutdown => return Ok(()),
+                    Wake::Timeout => tracing::warn!(
+                        waited_s = since.elapsed().as_secs(),
+                        "this host's chain has not finished tick {tick}"
+                    ),
+                    Wake::Ready => {}
+                }
+                lockstep.finished(|t| done = Some(done.map_or(t, |d| d.max(t))))?;
+            }
+            self.send(Kind::Tick(tick), tick)?;
+        }
+    }
+}
+
+/// Waits (at most `wait`) until the other host's bridge has started its chain, or names it.
+pub fn await_peer(
+    session: &zenoh::Session,
+    namespace: &str,
+    peer: &str,
+    wait: Duration,
+) -> anyhow::Result<()> {
+    let key = ready_key(namespace, peer);
+    let start = Instant::now();
+    loop {
+        let replies = session
+            .liveliness()
+            .get(key.clone())
+            .timeout(Duration::from_millis(500))
+            .wait()
+            .map_err(|e| anyhow::anyhow!("asking Zenoh for {key}: {e}"))?;
+        if replies.recv().is_ok_and(|r| r.result().is_ok()) {
+            return Ok(());
+        }
+        anyhow::ensure!(
+            start.elapsed() < wait,
+            "host {peer} never joined within {} s: start its share (`harvey launch FILE --host {peer}` with \
+             --zenoh-connect or --zenoh-listen pointing here)",
+            wait.as_secs()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}
