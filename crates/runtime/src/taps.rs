@@ -29,6 +29,10 @@ pub trait Tap {
     /// Hands every queued message to `f`, encoded into `buf` (reused) when `encode` is true;
     /// returns how many. Messages not encoded are still taken, so the queue never fills up.
     fn take(&self, encode: bool, buf: &mut Vec<u8>, f: &mut dyn FnMut(Taken)) -> anyhow::Result<usize>;
+    /// Hands every queued message to `f` as `(seq, stamp_ns, CDR)`, each encoded into a buffer
+    /// of its own that `f` keeps (a frame's pixels copied once, out of shared memory, and no
+    /// more); returns how many.
+    fn take_owned(&self, f: &mut dyn FnMut(u64, u64, Vec<u8>)) -> anyhow::Result<usize>;
 }
 
 /// The topic's schema as Foxglove and MCAP want it: `pkg/msg/Type` and the full `ros2msg` text.
@@ -61,6 +65,13 @@ impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
             }
             let cdr = if want { buf.as_slice() } else { &[] };
             f(Taken { seq: h.seq, stamp_ns: h.stamp_ns, cdr, frame: None });
+        })?)
+    }
+
+    fn take_owned(&self, f: &mut dyn FnMut(u64, u64, Vec<u8>)) -> anyhow::Result<usize> {
+        Ok(self.sub.drain(|m| {
+            let h = *m.header();
+            f(h.seq, h.stamp_ns, encode(m, Vec::new()));
         })?)
     }
 }
@@ -97,6 +108,20 @@ impl Tap for FrameTap {
             drop(frame);
             let cdr = if want { buf.as_slice() } else { &[] };
             f(Taken { seq: h.seq, stamp_ns: h.stamp_ns, cdr, frame: Some((h, pixel_bytes)) });
+            n += 1;
+        }
+        Ok(n)
+    }
+
+    fn take_owned(&self, f: &mut dyn FnMut(u64, u64, Vec<u8>)) -> anyhow::Result<usize> {
+        let mut n = 0;
+        while n < Qos::FRAMES.buffer
+            && let Some(frame) = self.sub.take()?
+        {
+            let h = *frame.header();
+            let cdr = encode_image(&h, frame.pixels(), Vec::new());
+            drop(frame);
+            f(h.seq, h.stamp_ns, cdr);
             n += 1;
         }
         Ok(n)
@@ -170,6 +195,10 @@ mod tests {
         assert_eq!(n, 1);
         assert_eq!((got[0].0, got[0].1), (7, 350_000_000));
         assert_eq!(got[0].2, encode(&sent, Vec::new()), "the recorder's bytes");
+        odometry.send(&sent).expect("send");
+        let mut owned = Vec::new();
+        assert_eq!(tap.take_owned(&mut |seq, stamp, cdr| owned.push((seq, stamp, cdr))).expect("take"), 1);
+        assert_eq!(owned, [(7, 350_000_000, encode(&sent, Vec::new()))], "the same bytes, owned");
         odometry.send(&sent).expect("send");
         let n = tap.take(false, &mut buf, &mut |m| assert!(m.cdr.is_empty())).expect("take");
         assert_eq!(n, 1, "taken, not encoded");

@@ -104,7 +104,7 @@ impl<'a> Chain<'a> {
     }
 
     /// Waits for the other host's next bundle; `None` if this process is asked to stop first.
-    fn receive(&self, waiter: &Waiter, waiting_for: &str) -> anyhow::Result<Option<Vec<u8>>> {
+    fn receive(&self, waiter: &Waiter, waiting_for: &str) -> anyhow::Result<Option<zenoh::bytes::ZBytes>> {
         let since = Instant::now();
         loop {
             if let Some(a) = self.inbox.next() {
@@ -157,7 +157,7 @@ impl<'a> Chain<'a> {
         else {
             return Ok(false);
         };
-        match self.publish(&reply)? {
+        match self.publish(&reply.to_bytes())? {
             Kind::Tick(t) if t == tick => Ok(true),
             other => anyhow::bail!("host {} answered tick {tick} with {other:?}", self.peer),
         }
@@ -195,7 +195,7 @@ impl<'a> Chain<'a> {
             .map_err(|e| anyhow::anyhow!("declaring this host ready on Zenoh: {e}"))?;
         loop {
             let Some(payload) = self.receive(&waiter, "the next tick")? else { return Ok(()) };
-            let tick = match self.publish(&payload)? {
+            let tick = match self.publish(&payload.to_bytes())? {
                 Kind::End => return Ok(()),
                 Kind::Tick(t) => t,
             };

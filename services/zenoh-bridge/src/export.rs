@@ -23,7 +23,6 @@ struct Out {
 pub struct Exporter {
     topics: Vec<&'static str>,
     outs: Vec<Out>,
-    buf: Vec<u8>,
     /// Messages stamped after the tick whose turn took them (deterministic mode), not put:
     /// the recorder leaves them out too.
     pub left_out: u64,
@@ -53,7 +52,7 @@ impl Exporter {
                 .map_err(|e| anyhow::anyhow!("cannot declare {live} on Zenoh: {e}"))?;
             outs.push(Out { publisher, fingerprint: wire::fingerprint(t.def()), _token: token, sent: 0 });
         }
-        Ok(Self { topics: taps.iter().map(|t| t.topic()).collect(), outs, buf: Vec::new(), left_out: 0 })
+        Ok(Self { topics: taps.iter().map(|t| t.topic()).collect(), outs, left_out: 0 })
     }
 
     /// Puts every message queued on `taps` (those it was made for) stamped at most `until_ns`,
@@ -62,18 +61,17 @@ impl Exporter {
         let (mut total, mut left_out) = (0, 0);
         for (tap, out) in taps.iter().zip(self.outs.iter_mut()) {
             let mut failed = None;
-            let n = tap.take(true, &mut self.buf, &mut |m| {
+            let n = tap.take_owned(&mut |seq, stamp_ns, cdr| {
                 if failed.is_some() {
                     return;
                 }
-                if m.stamp_ns > until_ns {
+                if stamp_ns > until_ns {
                     left_out += 1;
                     return;
                 }
-                let meta = Meta { seq: m.seq, stamp_ns: m.stamp_ns, fingerprint: out.fingerprint };
-                // One copy into Zenoh's buffer (the tap's CDR buffer is reused for the next).
-                let put = out.publisher.put(m.cdr.to_vec()).attachment(meta.encode().to_vec()).wait();
-                match put {
+                let meta = Meta { seq, stamp_ns, fingerprint: out.fingerprint };
+                // The CDR buffer goes to Zenoh as it is: no copy on the way.
+                match out.publisher.put(cdr).attachment(meta.encode().to_vec()).wait() {
                     Ok(()) => out.sent += 1,
                     Err(e) => failed = Some(anyhow::anyhow!("putting {} on Zenoh: {e}", tap.topic())),
                 }

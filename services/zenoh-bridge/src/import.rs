@@ -72,7 +72,7 @@ impl Importer {
                     continue;
                 }
             };
-            match sink.publish(&meta, &a.payload) {
+            match sink.publish(&meta, &a.payload.to_bytes()) {
                 Ok(()) => {
                     count.published += 1;
                     n += 1;

@@ -9,10 +9,10 @@ use std::sync::mpsc::{Receiver, Sender, channel};
 use zenoh::Wait;
 use zenoh::pubsub::Subscriber;
 
-/// A sample as it came off Zenoh.
+/// A sample as it came off Zenoh (its payload in Zenoh's own buffers, not copied).
 pub struct Arrived {
     pub key: String,
-    pub payload: Vec<u8>,
+    pub payload: zenoh::bytes::ZBytes,
     pub attachment: Option<Vec<u8>>,
 }
 
@@ -42,7 +42,7 @@ impl Mailbox {
             .callback(move |sample| {
                 let a = Arrived {
                     key: sample.key_expr().as_str().to_owned(),
-                    payload: sample.payload().to_bytes().into_owned(),
+                    payload: sample.payload().clone(),
                     attachment: sample.attachment().map(|a| a.to_bytes().into_owned()),
                 };
                 if tx.send(a).is_ok() {
