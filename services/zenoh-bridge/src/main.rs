@@ -100,7 +100,15 @@ fn check_name(flag: &str, name: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Zenoh's own log, unless `RUST_LOG` says otherwise: its warnings, without the one it gives
+/// every peer that runs without gossip, as the bridge always does (`session.rs`).
+const ZENOH_LOG: &str = "info,zenoh=warn,zenoh::net::routing::hat=error";
+
 fn main() -> anyhow::Result<()> {
+    if std::env::var_os("RUST_LOG").is_none() {
+        // SAFETY: first thing in main, before any thread exists.
+        unsafe { std::env::set_var("RUST_LOG", ZENOH_LOG) };
+    }
     harvey_runtime::init_logging();
     let args = Args::parse();
     check_name("--host", &args.host)?;
