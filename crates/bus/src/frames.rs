@@ -47,6 +47,11 @@ impl FramePublisher {
         self.topic
     }
 
+    /// This publisher, as its subscribers see it.
+    pub fn origin(&self) -> crate::Origin {
+        crate::Origin(self.port.id())
+    }
+
     pub fn max_frame_bytes(&self) -> usize {
         self.max_frame_bytes
     }
@@ -120,6 +125,11 @@ impl Frame {
 
     pub fn pixels(&self) -> &[u8] {
         self.sample.payload()
+    }
+
+    /// The publisher that sent it.
+    pub fn origin(&self) -> crate::Origin {
+        crate::Origin(self.sample.origin())
     }
 }
 

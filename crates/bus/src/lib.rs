@@ -28,7 +28,7 @@ pub use domain::{
 pub use error::BusError;
 pub use frames::{Frame, FrameLoan, FramePublisher, FrameSubscriber};
 pub use listing::{TopicInfo, iceoryx2_config, topics};
-pub use pubsub::{Publisher, Subscriber};
+pub use pubsub::{Origin, Publisher, Subscriber};
 pub use reoffer::{REOFFERED, ReofferRequests, Reoffers};
 pub use shm::domain_files;
 pub use waiter::{Attachment, FdSource, Waitable, Waiter, Wake};

@@ -65,6 +65,11 @@ fn open_service<T: Message>(
     apply_qos!(builder, qos).open_or_create().map_err(|e| open_error(topic.name, e))
 }
 
+/// Which publisher sent a message: a bridge takes what it published itself off its own
+/// subscriptions by this, never sending it back where it came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Origin(pub(crate) iceoryx2::identifiers::UniquePublisherId);
+
 /// Publishes messages of type `T` on one topic.
 pub struct Publisher<T: Message> {
     topic: &'static str,
@@ -89,6 +94,11 @@ impl<T: Message> Publisher<T> {
 
     pub fn topic(&self) -> &'static str {
         self.topic
+    }
+
+    /// This publisher, as its subscribers see it.
+    pub fn origin(&self) -> Origin {
+        Origin(self.port.id())
     }
 
     /// Sends one message and wakes the subscribers. Returns how many subscribers received it.
@@ -133,12 +143,17 @@ impl<T: Message> Subscriber<T> {
     /// Pending wake-ups are consumed before the queue is found empty, so a message that arrives
     /// later wakes the waiter again.
     pub fn drain(&self, mut f: impl FnMut(&T)) -> Result<usize> {
+        self.drain_with_origin(|m, _| f(m))
+    }
+
+    /// [`Subscriber::drain`], with each message's publisher.
+    pub fn drain_with_origin(&self, mut f: impl FnMut(&T, Origin)) -> Result<usize> {
         let mut n = 0;
         let mut receive_all = |n: &mut usize| -> Result<()> {
             while let Some(sample) =
                 self.port.receive().map_err(|e| BusError::topic(self.topic, "cannot receive", e))?
             {
-                f(sample.payload());
+                f(sample.payload(), Origin(sample.origin()));
                 *n += 1;
             }
             Ok(())

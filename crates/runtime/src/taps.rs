@@ -3,7 +3,7 @@
 //! `encode_image`) with its `ros2msg` schema (`harvey_cdr::full_text`), when asked for: a camera
 //! frame's header comes with it either way, read in place.
 
-use harvey_bus::{Bus, FrameSubscriber, Subscriber, Waitable};
+use harvey_bus::{Bus, FrameSubscriber, Origin, Subscriber, Waitable};
 use harvey_cdr::{Def, Ros2Msg, encode, encode_image, full_text, image_def};
 use harvey_msgs::{FrameHeader, Message, Qos, Topic, topics};
 
@@ -29,10 +29,14 @@ pub trait Tap {
     /// Hands every queued message to `f`, encoded into `buf` (reused) when `encode` is true;
     /// returns how many. Messages not encoded are still taken, so the queue never fills up.
     fn take(&self, encode: bool, buf: &mut Vec<u8>, f: &mut dyn FnMut(Taken)) -> anyhow::Result<usize>;
-    /// Hands every queued message to `f` as `(seq, stamp_ns, CDR)`, each encoded into a buffer
-    /// of its own that `f` keeps (a frame's pixels copied once, out of shared memory, and no
-    /// more); returns how many.
-    fn take_owned(&self, f: &mut dyn FnMut(u64, u64, Vec<u8>)) -> anyhow::Result<usize>;
+    /// Hands every queued message but those `skip` says no to by their publisher to `f` as
+    /// `(seq, stamp_ns, CDR)`, each encoded into a buffer of its own that `f` keeps (a frame's
+    /// pixels copied once, out of shared memory, and no more); returns how many were taken.
+    fn take_owned(
+        &self,
+        skip: &dyn Fn(Origin) -> bool,
+        f: &mut dyn FnMut(u64, u64, Vec<u8>),
+    ) -> anyhow::Result<usize>;
 }
 
 /// The topic's schema as Foxglove and MCAP want it: `pkg/msg/Type` and the full `ros2msg` text.
@@ -68,10 +72,16 @@ impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
         })?)
     }
 
-    fn take_owned(&self, f: &mut dyn FnMut(u64, u64, Vec<u8>)) -> anyhow::Result<usize> {
-        Ok(self.sub.drain(|m| {
-            let h = *m.header();
-            f(h.seq, h.stamp_ns, encode(m, Vec::new()));
+    fn take_owned(
+        &self,
+        skip: &dyn Fn(Origin) -> bool,
+        f: &mut dyn FnMut(u64, u64, Vec<u8>),
+    ) -> anyhow::Result<usize> {
+        Ok(self.sub.drain_with_origin(|m, from| {
+            if !skip(from) {
+                let h = *m.header();
+                f(h.seq, h.stamp_ns, encode(m, Vec::new()));
+            }
         })?)
     }
 }
@@ -113,11 +123,18 @@ impl Tap for FrameTap {
         Ok(n)
     }
 
-    fn take_owned(&self, f: &mut dyn FnMut(u64, u64, Vec<u8>)) -> anyhow::Result<usize> {
+    fn take_owned(
+        &self,
+        skip: &dyn Fn(Origin) -> bool,
+        f: &mut dyn FnMut(u64, u64, Vec<u8>),
+    ) -> anyhow::Result<usize> {
         let mut n = 0;
         while n < Qos::FRAMES.buffer
             && let Some(frame) = self.sub.take()?
         {
+            if skip(frame.origin()) {
+                continue;
+            }
             let h = *frame.header();
             let cdr = encode_image(&h, frame.pixels(), Vec::new());
             drop(frame);
@@ -197,8 +214,15 @@ mod tests {
         assert_eq!(got[0].2, encode(&sent, Vec::new()), "the recorder's bytes");
         odometry.send(&sent).expect("send");
         let mut owned = Vec::new();
-        assert_eq!(tap.take_owned(&mut |seq, stamp, cdr| owned.push((seq, stamp, cdr))).expect("take"), 1);
+        assert_eq!(
+            tap.take_owned(&|_| false, &mut |seq, stamp, cdr| owned.push((seq, stamp, cdr))).expect("take"),
+            1
+        );
         assert_eq!(owned, [(7, 350_000_000, encode(&sent, Vec::new()))], "the same bytes, owned");
+        odometry.send(&sent).expect("send");
+        let mine = odometry.origin();
+        tap.take_owned(&|from| from == mine, &mut |_, _, _| panic!("its own publisher's message is skipped"))
+            .expect("take");
         odometry.send(&sent).expect("send");
         let n = tap.take(false, &mut buf, &mut |m| assert!(m.cdr.is_empty())).expect("take");
         assert_eq!(n, 1, "taken, not encoded");

@@ -3,7 +3,7 @@
 //! stamp, so that messages and progress travel together and in order (one publisher, one key).
 //!
 //! Layout, little-endian: `HVC`, the layout byte, the tick's stamp (u64), a kind byte (0 a tick,
-//! 1 the end of the launch), the message count (u32), then per message its topic (u8 length,
+//! 1 the end of the launch, 2 real time's messages as they came), the message count (u32), then per message its topic (u8 length,
 //! bytes), seq (u64), stamp (u64), the definition's fingerprint (u32) and its CDR (u32 length,
 //! bytes).
 
@@ -18,6 +18,8 @@ pub enum Kind {
     Tick(u64),
     /// The sender's launch is ending: no more ticks.
     End,
+    /// Real time: messages as they came, no tick.
+    Live,
 }
 
 /// A bundle being written.
@@ -53,12 +55,18 @@ impl Writer {
         Ok(())
     }
 
+    /// Whether no message was pushed since the last bundle.
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
     /// The bundle's bytes, closed by `kind`; the writer is empty again.
     pub fn finish(&mut self, kind: Kind) -> Vec<u8> {
         self.buf[13..17].copy_from_slice(&self.count.to_le_bytes());
         let (stamp, k) = match kind {
             Kind::Tick(t) => (t, 0u8),
             Kind::End => (0, 1),
+            Kind::Live => (0, 2),
         };
         self.buf[4..12].copy_from_slice(&stamp.to_le_bytes());
         self.buf[12] = k;
@@ -98,6 +106,7 @@ pub fn read(b: &[u8]) -> anyhow::Result<(Kind, Vec<Item<'_>>)> {
     let kind = match take(1, "the kind")?[0] {
         0 => Kind::Tick(stamp),
         1 => Kind::End,
+        2 => Kind::Live,
         k => anyhow::bail!("bundle kind {k} unknown"),
     };
     let count = u64_of(take(4, "the count")?) as usize;

@@ -5,13 +5,15 @@
 //! the other host the bridge is the clock master: it publishes what came, starts the tick, waits
 //! for its chain's tail and sends back what its services published. Each direction is one key on
 //! one publisher, so a tick's messages and its progress arrive together and in order; what the
-//! bridge itself just published is taken off its taps and dropped, never sent back.
+//! bridge itself published is known by its publishers and never sent back. In real time there
+//! are no turns: each side sends what its services publish as it comes (`run_live`).
 
 use std::time::{Duration, Instant};
 
 use harvey_bus::{Bus, FdSource, Lockstep, Waiter, Wake};
 use harvey_runtime::taps::Tap;
 use zenoh::Wait;
+use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::Publisher;
 use zenoh::qos::CongestionControl;
 
@@ -41,7 +43,6 @@ pub struct Chain<'a> {
     peer: String,
     out: Publisher<'static>,
     inbox: Mailbox,
-    buf: Vec<u8>,
     /// What this host's services published since the last bundle went out.
     pending: bundle::Writer,
 }
@@ -63,16 +64,7 @@ impl<'a> Chain<'a> {
             .map_err(|e| anyhow::anyhow!("cannot publish {key} on Zenoh: {e}"))?;
         let mut inbox = Mailbox::new()?;
         inbox.subscribe(session, &chain_key(namespace, peer, host))?;
-        Ok(Self {
-            bus,
-            taps,
-            sinks,
-            peer: peer.to_owned(),
-            out,
-            inbox,
-            buf: Vec::new(),
-            pending: bundle::Writer::new(),
-        })
+        Ok(Self { bus, taps, sinks, peer: peer.to_owned(), out, inbox, pending: bundle::Writer::new() })
     }
 
     /// What rings when the other host's bundle arrives.
@@ -88,19 +80,69 @@ impl<'a> Chain<'a> {
         self.out.put(bundle).wait().map_err(|e| anyhow::anyhow!("sending to host {}: {e}", self.peer))
     }
 
-    /// Adds the messages queued on the taps stamped at most `until_ns` to what is pending.
+    /// Adds the messages queued on the taps stamped at most `until_ns` to what is pending, but
+    /// for those this bridge published itself (what came from the other host).
     fn collect(&mut self, until_ns: u64) -> anyhow::Result<()> {
+        let own = self.sinks.origins();
         let (w, mut failed) = (&mut self.pending, None);
         for tap in self.taps {
             let fingerprint = wire::fingerprint(tap.def());
-            tap.take(true, &mut self.buf, &mut |m| {
-                if m.stamp_ns <= until_ns && failed.is_none() {
-                    let meta = Meta { seq: m.seq, stamp_ns: m.stamp_ns, fingerprint };
-                    failed = w.push(tap.topic(), &meta, m.cdr).err();
+            tap.take_owned(&|from| own.contains(&from), &mut |seq, stamp_ns, cdr| {
+                if stamp_ns <= until_ns && failed.is_none() {
+                    let meta = Meta { seq, stamp_ns, fingerprint };
+                    failed = w.push(tap.topic(), &meta, &cdr).err();
                 }
             })?;
         }
         failed.map_or(Ok(()), Err)
+    }
+
+    /// Says this host's bridge is up (a liveliness token the other host's bridge waits for).
+    pub fn declare_ready(
+        &self,
+        session: &zenoh::Session,
+        namespace: &str,
+        host: &str,
+    ) -> anyhow::Result<LivelinessToken> {
+        session
+            .liveliness()
+            .declare_token(ready_key(namespace, host))
+            .wait()
+            .map_err(|e| anyhow::anyhow!("declaring this host ready on Zenoh: {e}"))
+    }
+
+    /// In real time: whatever this host's services publish goes to the other host as it comes,
+    /// and what comes is published here, until the main host ends the launch (a `Live` bundle
+    /// per wake-up; the order of each topic's messages is kept). The main host's bridge tells
+    /// the other it ends when it is stopped.
+    pub fn run_live(&mut self, main_side: bool) -> anyhow::Result<()> {
+        let waiter = Waiter::new()?;
+        let bell = FdSource::new(self.inbox.bell())?;
+        let mut attached = vec![waiter.attach(&bell)?];
+        for t in self.taps {
+            attached.push(waiter.attach(t.waitable())?);
+        }
+        loop {
+            if waiter.wait(Some(STALL_REPORT))? == Wake::Shutdown {
+                if main_side {
+                    self.end()?;
+                }
+                return Ok(());
+            }
+            self.collect(u64::MAX)?;
+            if !self.pending.is_empty() {
+                let bundle = self.pending.finish(Kind::Live);
+                self.out
+                    .put(bundle)
+                    .wait()
+                    .map_err(|e| anyhow::anyhow!("sending to host {}: {e}", self.peer))?;
+            }
+            while let Some(a) = self.inbox.next() {
+                if self.publish(&a.payload.to_bytes())? == Kind::End {
+                    return Ok(());
+                }
+            }
+        }
     }
 
     /// Waits for the other host's next bundle; `None` if this process is asked to stop first.
@@ -123,9 +165,9 @@ impl<'a> Chain<'a> {
         }
     }
 
-    /// Publishes a bundle's messages on the bus, then drops what the taps took of them. What
-    /// this host's services published before (outside the chain's turns: a standing request
-    /// made at start-up) is kept for the next bundle first.
+    /// Publishes a bundle's messages on the bus (the taps will skip them: their publishers are
+    /// this bridge's). What this host's services published before (outside the chain's turns:
+    /// a standing request made at start-up) is kept for the next bundle first.
     fn publish(&mut self, payload: &[u8]) -> anyhow::Result<Kind> {
         let (kind, items) =
             bundle::read(payload).map_err(|e| anyhow::anyhow!("from host {}: {e}", self.peer))?;
@@ -142,9 +184,6 @@ impl<'a> Chain<'a> {
             );
             sink.publish(&item.meta, item.cdr)
                 .map_err(|e| anyhow::anyhow!("{} from host {}: {e}", item.topic, self.peer))?;
-        }
-        for tap in self.taps {
-            tap.take(false, &mut self.buf, &mut |_| {})?;
         }
         Ok(kind)
     }
@@ -188,16 +227,16 @@ impl<'a> Chain<'a> {
             }
             lockstep.finished(|t| done = Some(t))?;
         }
-        let _ready = session
-            .liveliness()
-            .declare_token(ready_key(namespace, host))
-            .wait()
-            .map_err(|e| anyhow::anyhow!("declaring this host ready on Zenoh: {e}"))?;
+        let _ready = self.declare_ready(session, namespace, host)?;
         loop {
             let Some(payload) = self.receive(&waiter, "the next tick")? else { return Ok(()) };
             let tick = match self.publish(&payload.to_bytes())? {
                 Kind::End => return Ok(()),
                 Kind::Tick(t) => t,
+                Kind::Live => anyhow::bail!(
+                    "host {} runs in real time, this host deterministic: start both shares with --realtime or both without",
+                    self.peer
+                ),
             };
             lockstep.finish(tick)?;
             let since = Instant::now();

@@ -53,9 +53,9 @@ struct Args {
     /// chain) before giving up, naming them.
     #[arg(long, default_value_t = 30)]
     wait_s: u64,
-    /// Carry the clock chain to `--peer-host` (a deterministic launch split over two hosts,
-    /// `harvey launch FILE --host NAME`): `stand-in` on the main host, a party in place of the
-    /// other host's services; `segment` on the other host, its clock master. Every topic goes.
+    /// Carry every topic to and from `--peer-host` (a launch split over two hosts, `harvey
+    /// launch FILE --host NAME`): `stand-in` on the main host (in a deterministic launch a party
+    /// in place of the other host's services), `segment` on the other host (its clock master).
     #[arg(long, value_enum, requires = "peer_host", conflicts_with_all = ["export", "import"])]
     chain: Option<Role>,
     /// The other host of the chain.
@@ -134,7 +134,8 @@ fn main() -> anyhow::Result<()> {
     Ok(())
 }
 
-/// `--chain`: every topic, tick by tick, between this host and the other.
+/// `--chain`: every topic between this host and the other, tick by tick in a deterministic
+/// launch, as it comes in real time.
 fn run_chain(
     args: &Args,
     role: Role,
@@ -144,19 +145,24 @@ fn run_chain(
     pace: &Pace,
     sinks: &mut sinks::Sinks,
 ) -> anyhow::Result<()> {
-    let Some(lockstep) = pace.lockstep() else {
-        anyhow::bail!(
-            "--chain runs in a deterministic launch, as one of its clock parties (`harvey launch FILE --host NAME`)"
-        );
-    };
     let taps = harvey_runtime::taps::open_all(bus)?;
     let mut chain = chain::Chain::new(session, &args.namespace, (&args.host, peer), bus, &taps, sinks)?;
-    tracing::info!(host = args.host, peer, ?role, listen = ?args.listen, connect = ?args.connect, "carrying the clock chain over Zenoh");
+    let lockstep = pace.lockstep();
+    tracing::info!(host = args.host, peer, ?role, lockstep = lockstep.is_some(), listen = ?args.listen, connect = ?args.connect, "carrying every topic to the other host over Zenoh");
+    let wait = Duration::from_secs(args.wait_s);
+    let Some(lockstep) = lockstep else {
+        let _ready = chain.declare_ready(session, &args.namespace, &args.host)?;
+        if role == Role::StandIn {
+            chain::await_peer(session, &args.namespace, peer, wait)?;
+        }
+        harvey_runtime::notify_ready()?;
+        return chain.run_live(role == Role::StandIn);
+    };
     if role == Role::Segment {
         harvey_runtime::notify_ready()?;
         return chain.run_segment(session, &args.namespace, &args.host, lockstep);
     }
-    chain::await_peer(session, &args.namespace, peer, Duration::from_secs(args.wait_s))?;
+    chain::await_peer(session, &args.namespace, peer, wait)?;
     let waiter = Waiter::new()?;
     let _attached = pace.attach(&waiter, &[])?;
     let turn_waiter = Waiter::new()?;

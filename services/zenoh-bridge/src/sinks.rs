@@ -6,7 +6,7 @@
 
 use std::collections::BTreeMap;
 
-use harvey_bus::{Bus, FramePublisher, Publisher};
+use harvey_bus::{Bus, FramePublisher, Origin, Publisher};
 use harvey_cdr::{Ros2Msg, decode, decode_image, image_def};
 use harvey_msgs::{Message, Topic, topics};
 use harvey_recording::topics::{TopicVisitor, visit_message_topics};
@@ -16,6 +16,8 @@ use crate::wire::{self, Meta};
 /// What a topic's samples are published with.
 pub trait Sink {
     fn fingerprint(&self) -> u32;
+    /// Its publisher, as the bus's subscribers see it.
+    fn origin(&self) -> Origin;
     fn publish(&self, meta: &Meta, cdr: &[u8]) -> anyhow::Result<()>;
 }
 
@@ -27,6 +29,10 @@ struct MsgSink<T: Message> {
 impl<T: Message + Ros2Msg> Sink for MsgSink<T> {
     fn fingerprint(&self) -> u32 {
         self.fingerprint
+    }
+
+    fn origin(&self) -> Origin {
+        self.publisher.origin()
     }
 
     fn publish(&self, _meta: &Meta, cdr: &[u8]) -> anyhow::Result<()> {
@@ -44,6 +50,10 @@ struct FrameSink {
 impl Sink for FrameSink {
     fn fingerprint(&self) -> u32 {
         self.fingerprint
+    }
+
+    fn origin(&self) -> Origin {
+        self.publisher.origin()
     }
 
     fn publish(&self, meta: &Meta, cdr: &[u8]) -> anyhow::Result<()> {
@@ -94,6 +104,11 @@ impl Sinks {
     /// Frames up to `max_frame_bytes` are taken (a larger one is refused, named).
     pub fn new(max_frame_bytes: usize) -> Self {
         Self { sinks: BTreeMap::new(), max_frame_bytes }
+    }
+
+    /// The publishers of the sinks opened so far: what this bridge published itself.
+    pub fn origins(&self) -> Vec<Origin> {
+        self.sinks.values().map(|s| s.origin()).collect()
     }
 
     /// The sink of `topic` (a name of `topics::ALL`), opened on `bus` if it is not yet.
