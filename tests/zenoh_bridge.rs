@@ -138,41 +138,68 @@ fn diff(a: &std::path::Path, b: &std::path::Path) -> String {
     String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
-#[test]
-fn a_mission_split_over_two_hosts_records_what_it_records_on_one() {
+/// `missions/default-split.toml` run over two bus domains joined only by the two bridges: the
+/// gpu host's share started first, then the main host's, which must reach the goal and end the
+/// other's launch too. Returns the main host's run folder (to remove) after checking both
+/// domains' shared memory is gone.
+fn run_split(tag: &str, how: &[&str]) -> std::path::PathBuf {
     let mission = "missions/default-split.toml";
-    let (pa, pb) = (common::unique_prefix("zsa"), common::unique_prefix("zsb"));
-    let (main_dir, gpu_dir) = (common::scratch("zenoh-split-main"), common::scratch("zenoh-split-gpu"));
+    let (pa, pb) = (common::unique_prefix(&format!("{tag}a")), common::unique_prefix(&format!("{tag}b")));
+    let (main_dir, gpu_dir) =
+        (common::scratch(&format!("{tag}-main")), common::scratch(&format!("{tag}-gpu")));
     let at = format!("tcp/127.0.0.1:{}", free_port());
     let mut gpu =
         common::harvey(&["launch", mission, "--host", "gpu", "--prefix", &pb, "--zenoh-listen", &at])
+            .args(how)
             .args(["--run-dir", gpu_dir.to_str().expect("utf8")])
             .stdout(Stdio::null())
             .spawn()
             .expect("the gpu host's share");
     let main = common::harvey(&["run", mission, "--host", "main", "--prefix", &pa, "--zenoh-connect", &at])
+        .args(how)
         .args(["--run-dir", main_dir.to_str().expect("utf8")])
         .output()
         .expect("the main host's share");
     let stdout = String::from_utf8_lossy(&main.stdout);
     assert!(main.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&main.stderr));
     assert!(stdout.contains("goal reached"), "{stdout}");
-    // The main host's bridge ends the launch on the other host too.
     assert!(
         common::wait_exit(&mut gpu, Duration::from_secs(60)).success(),
         "the gpu host's launch ends cleanly"
     );
-
-    let one = common::run_mission(mission, "zenoh-split-one");
-    assert!(one.status.success(), "{}", one.stdout);
-    let verdict = diff(&one.dir.join("run.mcap"), &main_dir.join("run.mcap"));
-    assert!(verdict.starts_with("identical"), "split over two hosts against one host: {verdict}");
     for p in [&pa, &pb] {
         assert_eq!(common::shm_leftovers(p), Vec::<String>::new());
     }
-    for d in [&main_dir, &gpu_dir] {
-        std::fs::remove_dir_all(d).ok();
+    std::fs::remove_dir_all(&gpu_dir).ok();
+    main_dir
+}
+
+#[test]
+fn a_mission_split_over_two_hosts_records_what_it_records_on_one() {
+    let main_dir = run_split("zsplit", &[]);
+    let one = common::run_mission("missions/default-split.toml", "zenoh-split-one");
+    assert!(one.status.success(), "{}", one.stdout);
+    let verdict = diff(&one.dir.join("run.mcap"), &main_dir.join("run.mcap"));
+    assert!(verdict.starts_with("identical"), "split over two hosts against one host: {verdict}");
+    std::fs::remove_dir_all(&main_dir).ok();
+}
+
+#[test]
+fn a_mission_split_over_two_hosts_runs_in_real_time_too() {
+    let main_dir = run_split("zlive", &["--realtime"]);
+    // The gpu host's services were heard on the main host: the vision workers' detections and
+    // the UMS's maps, on about every frame and tick of the 26 s run.
+    let recording = harvey_recording::Recording::open(&main_dir.join("run.mcap")).expect("recording");
+    let (mut detections, mut maps) = (0, 0);
+    for m in recording.messages().expect("messages") {
+        match m.expect("reads").topic() {
+            "vision/detections" => detections += 1,
+            "ums/map" => maps += 1,
+            _ => {}
+        }
     }
+    assert!(detections > 200 && maps > 400, "{detections} detections, {maps} maps from host gpu");
+    std::fs::remove_dir_all(&main_dir).ok();
 }
 
 #[test]
@@ -195,46 +222,4 @@ fn a_host_that_never_joins_is_named() {
     assert!(!unknown.status.success() && err.contains("none on `tpu`"), "{err}");
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
     std::fs::remove_dir_all(&dir).ok();
-}
-
-#[test]
-fn a_mission_split_over_two_hosts_runs_in_real_time_too() {
-    let mission = "missions/default-split.toml";
-    let (pa, pb) = (common::unique_prefix("zra"), common::unique_prefix("zrb"));
-    let (main_dir, gpu_dir) = (common::scratch("zenoh-live-main"), common::scratch("zenoh-live-gpu"));
-    let at = format!("tcp/127.0.0.1:{}", free_port());
-    let mut gpu = common::harvey(&["launch", mission, "--host", "gpu", "--realtime", "--prefix", &pb])
-        .args(["--zenoh-listen", &at, "--run-dir", gpu_dir.to_str().expect("utf8")])
-        .stdout(Stdio::null())
-        .spawn()
-        .expect("the gpu host's share");
-    let main = common::harvey(&["run", mission, "--host", "main", "--realtime", "--prefix", &pa])
-        .args(["--zenoh-connect", &at, "--run-dir", main_dir.to_str().expect("utf8")])
-        .output()
-        .expect("the main host's share");
-    let stdout = String::from_utf8_lossy(&main.stdout);
-    assert!(main.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&main.stderr));
-    assert!(stdout.contains("goal reached"), "{stdout}");
-    assert!(
-        common::wait_exit(&mut gpu, Duration::from_secs(60)).success(),
-        "the gpu host's launch ends cleanly"
-    );
-    // The gpu host's services were heard on the main host: the vision workers' detections and
-    // the UMS's maps, on about every frame and tick of the 26 s run.
-    let recording = harvey_recording::Recording::open(&main_dir.join("run.mcap")).expect("recording");
-    let (mut detections, mut maps) = (0, 0);
-    for m in recording.messages().expect("messages") {
-        match m.expect("reads").topic() {
-            "vision/detections" => detections += 1,
-            "ums/map" => maps += 1,
-            _ => {}
-        }
-    }
-    assert!(detections > 200 && maps > 400, "{detections} detections, {maps} maps from host gpu");
-    for p in [&pa, &pb] {
-        assert_eq!(common::shm_leftovers(p), Vec::<String>::new());
-    }
-    for d in [&main_dir, &gpu_dir] {
-        std::fs::remove_dir_all(d).ok();
-    }
 }

@@ -9,24 +9,31 @@ use zenoh::Wait;
 
 use crate::wire;
 
-/// `(layout, host, topic)` of every liveliness token live in `namespace` now.
-fn live_tokens(session: &zenoh::Session, namespace: &str) -> anyhow::Result<Vec<(String, String, String)>> {
-    let key = wire::live_all(namespace);
+/// The keys of the liveliness tokens live now that match `key`.
+pub fn live_keys(session: &zenoh::Session, key: &str) -> anyhow::Result<Vec<String>> {
     let replies = session
         .liveliness()
-        .get(key.clone())
+        .get(key.to_owned())
         .timeout(Duration::from_millis(500))
         .wait()
         .map_err(|e| anyhow::anyhow!("asking Zenoh for {key}: {e}"))?;
     let mut out = Vec::new();
     while let Ok(reply) = replies.recv() {
-        if let Ok(sample) = reply.result()
-            && let Some((layout, host, topic)) = wire::parse_live_key(namespace, sample.key_expr().as_str())
-        {
-            out.push((layout.to_owned(), host.to_owned(), topic.to_owned()));
+        if let Ok(sample) = reply.result() {
+            out.push(sample.key_expr().as_str().to_owned());
         }
     }
     Ok(out)
+}
+
+/// `(layout, host, topic)` of every liveliness token live in `namespace` now.
+fn live_tokens(session: &zenoh::Session, namespace: &str) -> anyhow::Result<Vec<(String, String, String)>> {
+    let keys = live_keys(session, &wire::live_all(namespace))?;
+    Ok(keys
+        .iter()
+        .filter_map(|k| wire::parse_live_key(namespace, k))
+        .map(|(layout, host, topic)| (layout.to_owned(), host.to_owned(), topic.to_owned()))
+        .collect())
 }
 
 /// Waits until a host of this layout exports each of `topics`, at most `wait`.
