@@ -28,7 +28,7 @@ enum Cmd {
         /// Run every service in this one process, one thread, on in-memory topics (the
         /// simulated DRV and the bridge on an in-memory serial line): the same recording as under
         /// the supervisor, with no processes and no shared memory (deterministic launches).
-        #[arg(long, conflicts_with_all = ["live", "foxglove", "realtime", "zenoh_listen", "zenoh_connect", "host"])]
+        #[arg(long, conflicts_with_all = ["live", "foxglove", "realtime", "zenoh_listen", "zenoh_connect", "host", "ros2_domain"])]
         in_process: bool,
         #[command(flatten)]
         opts: LaunchArgs,
@@ -63,7 +63,7 @@ enum Cmd {
         trust_recording: bool,
         /// Run the services as nodes of this one process, one thread, with the same messages
         /// in the same order as over shared memory, and no processes (hundreds of times faster).
-        #[arg(long, conflicts_with_all = ["live", "foxglove", "realtime", "zenoh_listen", "zenoh_connect", "host"])]
+        #[arg(long, conflicts_with_all = ["live", "foxglove", "realtime", "zenoh_listen", "zenoh_connect", "host", "ros2_domain"])]
         in_process: bool,
         #[command(flatten)]
         opts: LaunchArgs,
@@ -143,6 +143,7 @@ fn run(cli: Cli) -> anyhow::Result<i32> {
             zenoh_listen: Vec::new(),
             zenoh_connect: Vec::new(),
             host: None,
+            ros2_domain: None,
         },
     });
     match cmd {

@@ -30,7 +30,10 @@ pub fn supervise(file: &Path, args: &LaunchArgs) -> anyhow::Result<i32> {
     } else if args.zenoh() {
         // First, as the Foxglove bridge: its peers connect before anything publishes. In a
         // deterministic launch it is the party before the recorder (the chain wraps round).
-        lf.services.insert(0, super::zenoh::zenoh_service(&args.zenoh_listen, &args.zenoh_connect)?);
+        lf.services.insert(
+            0,
+            super::zenoh::zenoh_service(&args.zenoh_listen, &args.zenoh_connect, args.ros2_domain)?,
+        );
     }
     let outcome = harvey_supervisor::run(&lf, &launch_options(&lf, args), &mut line)?;
     line.report(&outcome)?;

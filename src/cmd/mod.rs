@@ -54,6 +54,10 @@ pub struct LaunchArgs {
     /// `--zenoh-listen`/`--zenoh-connect` (`docs/zenoh.md`).
     #[arg(long, value_name = "NAME")]
     pub host: Option<String>,
+    /// With `--zenoh-listen`/`--zenoh-connect`: also publish every topic as ROS 2 Jazzy's
+    /// `rmw_zenoh_cpp` does in this `ROS_DOMAIN_ID`, for `ros2 topic list/echo` (`docs/zenoh.md`).
+    #[arg(long, value_name = "DOMAIN_ID", value_parser = clap::value_parser!(u32).range(0..=232))]
+    pub ros2_domain: Option<u32>,
 }
 
 impl LaunchArgs {
@@ -97,7 +101,8 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
             "zenoh: host {host}'s share (listen {:?}, connect {:?})",
             args.zenoh_listen, args.zenoh_connect
         );
-    } else if args.zenoh() {
+    } else if args.zenoh() || args.ros2_domain.is_some() {
+        anyhow::ensure!(args.zenoh(), "--ros2-domain: give --zenoh-listen or --zenoh-connect too");
         zenoh::check_endpoints(&args.zenoh_listen, &args.zenoh_connect)?;
         println!(
             "zenoh: every topic exported (listen {:?}, connect {:?})",
@@ -123,6 +128,9 @@ fn launch_file(file: &Path, args: &LaunchArgs) -> anyhow::Result<(harvey_supervi
         }
         if let Some(host) = &args.host {
             cmd.args(["--host", host]);
+        }
+        if let Some(d) = args.ros2_domain {
+            cmd.args(["--ros2-domain", &d.to_string()]);
         }
         cmd
     };

@@ -136,6 +136,7 @@ mod tests {
             zenoh_listen: Vec::new(),
             zenoh_connect: Vec::new(),
             host: None,
+            ros2_domain: None,
         };
         let how = How { check: false, rrd: false, trust: false, in_process: false };
         assert!(run(&recording, how, opts).is_err(), "a bad prefix is refused");

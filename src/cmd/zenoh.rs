@@ -10,8 +10,12 @@ pub const ZENOH_SERVICE: &str = "zenoh-bridge";
 pub fn zenoh_service(
     listen: &[String],
     connect: &[String],
+    ros2_domain: Option<u32>,
 ) -> anyhow::Result<harvey_supervisor::config::Service> {
     let mut args = vec!["--export".to_owned(), "all".to_owned()];
+    if let Some(d) = ros2_domain {
+        args.extend(["--ros2-domain".to_owned(), d.to_string()]);
+    }
     for e in listen {
         args.extend(["--zenoh-listen".to_owned(), e.clone()]);
     }
@@ -50,8 +54,8 @@ mod tests {
 
     #[test]
     fn the_zenoh_service_exports_everything_on_the_endpoints_given() {
-        let s =
-            zenoh_service(&["tcp/127.0.0.1:7447".into()], &["tcp/10.0.0.2:7447".into()]).expect("service");
+        let s = zenoh_service(&["tcp/127.0.0.1:7447".into()], &["tcp/10.0.0.2:7447".into()], None)
+            .expect("service");
         assert_eq!((s.name(), s.binary_name().as_str()), ("zenoh-bridge", "harvey-zenoh-bridge"));
         assert_eq!(
             s.args,
@@ -65,6 +69,8 @@ mod tests {
             ]
         );
         assert!(s.clock_party);
+        let ros = zenoh_service(&["tcp/127.0.0.1:7447".into()], &[], Some(3)).expect("service");
+        assert_eq!(ros.args[..4], ["--export", "all", "--ros2-domain", "3"]);
         assert!(check_endpoints(&["tcp/127.0.0.1:0".into()], &[]).is_ok());
         let e = check_endpoints(&["127.0.0.1:7447".into()], &[]).expect_err("no tcp/").to_string();
         assert!(e.contains("--zenoh-listen 127.0.0.1:7447: not `tcp/HOST:PORT`"), "{e}");

@@ -18,6 +18,7 @@ mod export;
 mod import;
 mod mailbox;
 mod peers;
+mod ros2;
 mod session;
 mod sinks;
 mod wire;
@@ -58,6 +59,11 @@ struct Args {
     /// in place of the other host's services), `segment` on the other host (its clock master).
     #[arg(long, value_enum, requires = "peer_host", conflicts_with_all = ["export", "import"])]
     chain: Option<Role>,
+    /// Also put every exported topic as ROS 2 (Jazzy, `rmw_zenoh_cpp`) does in this
+    /// `ROS_DOMAIN_ID`: keys with RIHS01 type hashes, rmw_zenoh's attachment and liveliness
+    /// tokens, so that `ros2 topic list/echo` there sees them (`docs/zenoh.md`).
+    #[arg(long, value_name = "DOMAIN_ID", value_parser = clap::value_parser!(u32).range(0..=232))]
+    ros2_domain: Option<u32>,
     /// The other host of the chain.
     #[arg(long)]
     peer_host: Option<String>,
@@ -200,7 +206,7 @@ fn run_topics(
          run it with --realtime, or export only"
     );
     let taps = harvey_runtime::taps::open(bus, |t| export.iter().any(|e| e == t))?;
-    let mut exporter = export::Exporter::new(session, &args.namespace, &args.host, &taps)?;
+    let mut exporter = export::Exporter::new(session, &args.namespace, &args.host, &taps, args.ros2_domain)?;
     let mut importer = import::Importer::new(session, bus, sinks, &args.namespace, &args.import)?;
     if !args.import.is_empty() {
         peers::await_exporters(session, &args.namespace, &args.import, Duration::from_secs(args.wait_s))?;
