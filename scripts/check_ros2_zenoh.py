@@ -15,16 +15,10 @@ usage: check_ros2_zenoh.py PORT DOMAIN RUN_MCAP -- COMMAND...
 """
 
 import struct
-import subprocess
 import sys
-import threading
-import time
 
-import zenoh
-from mcap.reader import make_reader
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-
-DERIVED = ("/tf", "/tf_static", "/markers/", "/camera/camera_info")
+from zenoh_peer import watch
 
 
 def main() -> int:
@@ -32,46 +26,10 @@ def main() -> int:
         print(__doc__, file=sys.stderr)
         return 2
     port, domain, mcap_path, command = int(sys.argv[1]), sys.argv[2], sys.argv[3], sys.argv[5:]
-    conf = zenoh.Config()
-    conf.insert_json5("mode", '"peer"')
-    conf.insert_json5("listen/endpoints", f'["tcp/127.0.0.1:{port}"]')
-    conf.insert_json5("scouting/multicast/enabled", "false")
-    conf.insert_json5("scouting/gossip/enabled", "false")
-    got, tokens, lock = {}, set(), threading.Lock()
-
-    def on_sample(sample):
-        att = sample.attachment.to_bytes() if sample.attachment is not None else b""
-        with lock:
-            got.setdefault(str(sample.key_expr), []).append((att, sample.payload.to_bytes()))
-
-    def on_token(sample):
-        with lock:
-            tokens.add(str(sample.key_expr))
-
-    with zenoh.open(conf) as session:
-        sub = session.declare_subscriber(f"{domain}/**", on_sample)
-        live = session.liveliness().declare_subscriber(f"@ros2_lv/{domain}/**", on_token, history=True)
-        run = subprocess.run(command)
-        if run.returncode != 0:
-            print(f"check_ros2_zenoh: the run failed ({run.returncode})", file=sys.stderr)
-            return 1
-        expected, schemas = {}, {}
-        with open(mcap_path, "rb") as f:
-            for schema, channel, message in make_reader(f).iter_messages():
-                if channel.topic.startswith(DERIVED):
-                    continue
-                expected.setdefault(channel.topic, []).append(message)
-                schemas[channel.topic] = (schema.name, schema.data.decode())
-        want = sum(len(v) for v in expected.values())
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            with lock:
-                if sum(len(v) for v in got.values()) >= want:
-                    break
-            time.sleep(0.1)
-        sub.undeclare()
-        live.undeclare()
-
+    watched = watch(port, f"{domain}/**", command, mcap_path, liveliness=f"@ros2_lv/{domain}/**")
+    if watched is None:
+        return 1
+    got, tokens, expected, schemas = watched
     problems, decoded = [], 0
     by_topic = {}
     for key in got:

@@ -9,15 +9,9 @@ usage: check_zenoh.py PORT RUN_MCAP -- COMMAND...
 """
 
 import struct
-import subprocess
 import sys
-import threading
-import time
 
-import zenoh
-from mcap.reader import make_reader
-
-DERIVED = ("/tf", "/tf_static", "/markers/", "/camera/camera_info")
+from zenoh_peer import watch
 
 
 def main() -> int:
@@ -25,41 +19,11 @@ def main() -> int:
         print(__doc__, file=sys.stderr)
         return 2
     port, mcap_path, command = int(sys.argv[1]), sys.argv[2], sys.argv[4:]
-    conf = zenoh.Config()
-    conf.insert_json5("mode", '"peer"')
-    conf.insert_json5("listen/endpoints", f'["tcp/127.0.0.1:{port}"]')
-    conf.insert_json5("scouting/multicast/enabled", "false")
-    conf.insert_json5("scouting/gossip/enabled", "false")
-    got = {}
-    lock = threading.Lock()
-
-    def on_sample(sample):
-        att = sample.attachment.to_bytes() if sample.attachment is not None else b""
-        key = str(sample.key_expr)
-        with lock:
-            got.setdefault(key, []).append((att, sample.payload.to_bytes()))
-
-    with zenoh.open(conf) as session:
-        sub = session.declare_subscriber("harvey/**", on_sample)
-        run = subprocess.run(command)
-        if run.returncode != 0:
-            print(f"check_zenoh: the run failed ({run.returncode})", file=sys.stderr)
-            return 1
-        expected = {}
-        with open(mcap_path, "rb") as f:
-            for _schema, channel, message in make_reader(f).iter_messages():
-                if channel.topic.startswith(DERIVED):
-                    continue
-                expected.setdefault("harvey" + channel.topic, []).append(message)
-        want = sum(len(v) for v in expected.values())
-        # The bridge has put everything before the run ended; what is in flight arrives soon.
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            with lock:
-                if sum(len(v) for v in got.values()) >= want:
-                    break
-            time.sleep(0.1)
-        sub.undeclare()
+    watched = watch(port, "harvey/**", command, mcap_path)
+    if watched is None:
+        return 1
+    got, _, recorded, _ = watched
+    expected = {"harvey" + topic: messages for topic, messages in recorded.items()}
     problems = []
     for key, messages in sorted(expected.items()):
         samples = got.get(key, [])
