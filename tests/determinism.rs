@@ -6,14 +6,15 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Output;
 
 fn text(out: &Output) -> String {
     format!("{}\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr))
 }
 
-fn run(mission: &Path, tag: &str) -> PathBuf {
+/// The run's folder (its recording is `run.mcap` there).
+fn run(mission: &Path, tag: &str) -> common::Scratch {
     let (prefix, dir) = (common::unique_prefix(tag), common::scratch(tag));
     let out = common::harvey(&[
         "run",
@@ -27,7 +28,7 @@ fn run(mission: &Path, tag: &str) -> PathBuf {
     .expect("runs");
     assert!(out.status.success(), "{}", text(&out));
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
-    dir.join("run.mcap")
+    dir
 }
 
 /// The number in "identical: N messages ...".
@@ -50,6 +51,7 @@ fn the_same_seed_records_the_same_messages_and_another_seed_does_not() {
         let b = s.spawn(|| run(&default, "det-b"));
         (a.join().expect("run a"), b.join().expect("run b"))
     });
+    let (a, b) = (a.join("run.mcap"), b.join("run.mcap"));
     let same = diff(&a, &b);
     assert_eq!(same.status.code(), Some(0), "{}", text(&same));
     let n = agreed(&same);
@@ -60,9 +62,11 @@ fn the_same_seed_records_the_same_messages_and_another_seed_does_not() {
         .expect("default mission")
         .replace("seed = 1", "seed = 2")
         .replace("../worlds/hallway.toml", world.to_str().expect("utf8"));
-    let file = common::scratch("det-seed").join("seed2.toml");
+    let seed_dir = common::scratch("det-seed");
+    let file = seed_dir.join("seed2.toml");
     std::fs::write(&file, seeded).expect("written");
-    let c = run(&file, "det-c");
+    let c_dir = run(&file, "det-c");
+    let c = c_dir.join("run.mcap");
     let other = diff(&a, &c);
     let out = String::from_utf8_lossy(&other.stdout);
     assert_eq!(other.status.code(), Some(1), "{}", text(&other));

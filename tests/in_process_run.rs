@@ -5,7 +5,7 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Output;
 
 fn text(out: &Output) -> String {
@@ -13,8 +13,8 @@ fn text(out: &Output) -> String {
 }
 
 /// Runs `mission` under the supervisor (`in_process` false) or in process; its output and
-/// recording.
-fn run(mission: &str, tag: &str, in_process: bool) -> (Output, PathBuf) {
+/// run folder (its recording is `run.mcap` there).
+fn run(mission: &str, tag: &str, in_process: bool) -> (Output, common::Scratch) {
     let (prefix, dir) = (common::unique_prefix(tag), common::scratch(tag));
     let mut args = vec!["run", mission, "--prefix", &prefix, "--run-dir", dir.to_str().expect("utf8")];
     if in_process {
@@ -24,7 +24,7 @@ fn run(mission: &str, tag: &str, in_process: bool) -> (Output, PathBuf) {
     assert!(out.status.success(), "{mission} (in process: {in_process}): {}", text(&out));
     // In process nothing touches shared memory; under the supervisor everything is cleaned up.
     assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
-    (out, dir.join("run.mcap"))
+    (out, dir)
 }
 
 fn diff(a: &Path, b: &Path) -> Output {
@@ -41,7 +41,7 @@ fn both_ways(mission: &str, tag: &str) -> usize {
         let b = s.spawn(|| run(mission, &format!("{tag}-ip"), true));
         (a.join().expect("multi-process run"), b.join().expect("in-process run"))
     });
-    let same = diff(&a, &b);
+    let same = diff(&a.join("run.mcap"), &b.join("run.mcap"));
     assert_eq!(same.status.code(), Some(0), "{mission}: {}", text(&same));
     // Both print the same mission summary; the in-process run says how fast it went.
     let summary = |o: &Output| {

@@ -37,7 +37,7 @@ fn chaos(tag: &str, services: &str, kills: usize, seed: u64) -> (Vec<Row>, Strin
 }
 
 /// As [`chaos`], also giving the output folder (each run's `launch.log` is in `run-NNN/`).
-fn chaos_in(tag: &str, services: &str, kills: usize, seed: u64) -> (Vec<Row>, String, std::path::PathBuf) {
+fn chaos_in(tag: &str, services: &str, kills: usize, seed: u64) -> (Vec<Row>, String, common::Scratch) {
     let out = common::scratch(tag);
     let prefix = common::unique_prefix(tag);
     let run = common::harvey(&[

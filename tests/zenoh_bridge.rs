@@ -142,7 +142,7 @@ fn diff(a: &std::path::Path, b: &std::path::Path) -> String {
 /// gpu host's share started first, then the main host's, which must reach the goal and end the
 /// other's launch too. Returns the main host's run folder (to remove) after checking both
 /// domains' shared memory is gone.
-fn run_split(tag: &str, how: &[&str]) -> std::path::PathBuf {
+fn run_split(tag: &str, how: &[&str]) -> common::Scratch {
     let mission = "missions/default-split.toml";
     let (pa, pb) = (common::unique_prefix(&format!("{tag}a")), common::unique_prefix(&format!("{tag}b")));
     let (main_dir, gpu_dir) =

@@ -32,12 +32,45 @@ pub fn unique_prefix(tag: &str) -> String {
     format!("t{}{}{}_", tag, std::process::id(), N.fetch_add(1, Ordering::Relaxed))
 }
 
-/// A fresh scratch folder under the target directory.
-pub fn scratch(tag: &str) -> PathBuf {
+/// A fresh scratch folder under the target directory, removed when the test passes and kept
+/// (and named) when it fails: the runs' recordings are hundreds of MB, and CI's disk is finite.
+pub fn scratch(tag: &str) -> Scratch {
     let d = bin_dir().join("test-scratch").join(format!("{tag}-{}", unique_prefix("")));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).expect("scratch folder");
-    d
+    Scratch(d)
+}
+
+/// A scratch folder; see [`scratch`].
+pub struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<std::ffi::OsStr> for Scratch {
+    fn as_ref(&self) -> &std::ffi::OsStr {
+        self.0.as_os_str()
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            eprintln!("kept for a look: {}", self.0.display());
+        } else {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
 }
 
 /// Shared-memory objects of a bus prefix still in /dev/shm.
@@ -108,17 +141,7 @@ pub struct MissionRun {
     /// The recording's bytes.
     pub mcap: Vec<u8>,
     /// The run folder: removed when the test passes, kept (and named) when it fails.
-    pub dir: PathBuf,
-}
-
-impl Drop for MissionRun {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            eprintln!("the run is kept in {}", self.dir.display());
-        } else {
-            let _ = std::fs::remove_dir_all(&self.dir);
-        }
-    }
+    pub dir: Scratch,
 }
 
 /// Runs `mission` (a path from the repository root, or absolute) in one process (`harvey run
@@ -192,7 +215,7 @@ pub fn holds(m: &harvey_msgs::UncertaintyMap, x: f64, y: f64, th: f64, tol: f64)
 
 /// `harvey replay --check` of `recording`, under its own bus prefix and scratch run folder.
 #[allow(dead_code)]
-pub fn replay_check(recording: &Path, tag: &str) -> (std::process::Output, String, PathBuf) {
+pub fn replay_check(recording: &Path, tag: &str) -> (std::process::Output, String, Scratch) {
     replay_check_with(recording, tag, &[])
 }
 
@@ -202,7 +225,7 @@ pub fn replay_check_with(
     recording: &Path,
     tag: &str,
     more: &[&str],
-) -> (std::process::Output, String, PathBuf) {
+) -> (std::process::Output, String, Scratch) {
     let (prefix, dir) = (unique_prefix(tag), scratch(tag));
     let out = harvey(&[
         "replay",
