@@ -70,6 +70,13 @@ fn open_service<T: Message>(
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Origin(pub(crate) iceoryx2::identifiers::UniquePublisherId);
 
+/// The publisher's id in hex, unique on this host (a restarted service's publishers get new ones).
+impl std::fmt::Display for Origin {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
 /// Publishes messages of type `T` on one topic.
 pub struct Publisher<T: Message> {
     topic: &'static str,

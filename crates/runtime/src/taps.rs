@@ -30,12 +30,12 @@ pub trait Tap {
     /// returns how many. Messages not encoded are still taken, so the queue never fills up.
     fn take(&self, encode: bool, buf: &mut Vec<u8>, f: &mut dyn FnMut(Taken)) -> anyhow::Result<usize>;
     /// Hands every queued message but those `skip` says no to by their publisher to `f` as
-    /// `(seq, stamp_ns, CDR)`, each encoded into a buffer of its own that `f` keeps (a frame's
+    /// `(publisher, seq, stamp_ns, CDR)`, each encoded into a buffer of its own that `f` keeps (a frame's
     /// pixels copied once, out of shared memory, and no more); returns how many were taken.
     fn take_owned(
         &self,
         skip: &dyn Fn(Origin) -> bool,
-        f: &mut dyn FnMut(u64, u64, Vec<u8>),
+        f: &mut dyn FnMut(Origin, u64, u64, Vec<u8>),
     ) -> anyhow::Result<usize>;
 }
 
@@ -75,12 +75,12 @@ impl<T: Message + Ros2Msg> Tap for MsgTap<T> {
     fn take_owned(
         &self,
         skip: &dyn Fn(Origin) -> bool,
-        f: &mut dyn FnMut(u64, u64, Vec<u8>),
+        f: &mut dyn FnMut(Origin, u64, u64, Vec<u8>),
     ) -> anyhow::Result<usize> {
         Ok(self.sub.drain_with_origin(|m, from| {
             if !skip(from) {
                 let h = *m.header();
-                f(h.seq, h.stamp_ns, encode(m, Vec::new()));
+                f(from, h.seq, h.stamp_ns, encode(m, Vec::new()));
             }
         })?)
     }
@@ -126,19 +126,20 @@ impl Tap for FrameTap {
     fn take_owned(
         &self,
         skip: &dyn Fn(Origin) -> bool,
-        f: &mut dyn FnMut(u64, u64, Vec<u8>),
+        f: &mut dyn FnMut(Origin, u64, u64, Vec<u8>),
     ) -> anyhow::Result<usize> {
         let mut n = 0;
         while n < Qos::FRAMES.buffer
             && let Some(frame) = self.sub.take()?
         {
-            if skip(frame.origin()) {
+            let from = frame.origin();
+            if skip(from) {
                 continue;
             }
             let h = *frame.header();
             let cdr = encode_image(&h, frame.pixels(), Vec::new());
             drop(frame);
-            f(h.seq, h.stamp_ns, cdr);
+            f(from, h.seq, h.stamp_ns, cdr);
             n += 1;
         }
         Ok(n)
@@ -215,14 +216,20 @@ mod tests {
         odometry.send(&sent).expect("send");
         let mut owned = Vec::new();
         assert_eq!(
-            tap.take_owned(&|_| false, &mut |seq, stamp, cdr| owned.push((seq, stamp, cdr))).expect("take"),
+            tap.take_owned(&|_| false, &mut |from, seq, stamp, cdr| {
+                assert_eq!(from, odometry.origin());
+                owned.push((seq, stamp, cdr))
+            })
+            .expect("take"),
             1
         );
         assert_eq!(owned, [(7, 350_000_000, encode(&sent, Vec::new()))], "the same bytes, owned");
         odometry.send(&sent).expect("send");
         let mine = odometry.origin();
-        tap.take_owned(&|from| from == mine, &mut |_, _, _| panic!("its own publisher's message is skipped"))
-            .expect("take");
+        tap.take_owned(&|from| from == mine, &mut |_, _, _, _| {
+            panic!("its own publisher's message is skipped")
+        })
+        .expect("take");
         odometry.send(&sent).expect("send");
         let n = tap.take(false, &mut buf, &mut |m| assert!(m.cdr.is_empty())).expect("take");
         assert_eq!(n, 1, "taken, not encoded");

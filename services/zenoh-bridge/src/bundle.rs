@@ -3,7 +3,8 @@
 //! stamp, so that messages and progress travel together and in order (one publisher, one key).
 //!
 //! Layout, little-endian: `HVC`, the layout byte, the tick's stamp (u64), a kind byte (0 a tick,
-//! 1 the end of the launch, 2 real time's messages as they came), the message count (u32), then per message its topic (u8 length,
+//! 1 the end of the launch, 2 real time's messages as they came, 3 a restarted bridge asking for
+//! the tick after the stamp), the message count (u32), then per message its topic (u8 length,
 //! bytes), seq (u64), stamp (u64), the definition's fingerprint (u32) and its CDR (u32 length,
 //! bytes).
 
@@ -20,6 +21,9 @@ pub enum Kind {
     End,
     /// Real time: messages as they came, no tick.
     Live,
+    /// The sender was restarted; its last finished tick is this one: the tick under way, if
+    /// later, is to be sent again (it may have gone while nobody listened).
+    Resync(u64),
 }
 
 /// A bundle being written.
@@ -67,6 +71,7 @@ impl Writer {
             Kind::Tick(t) => (t, 0u8),
             Kind::End => (0, 1),
             Kind::Live => (0, 2),
+            Kind::Resync(t) => (t, 3),
         };
         self.buf[4..12].copy_from_slice(&stamp.to_le_bytes());
         self.buf[12] = k;
@@ -107,6 +112,7 @@ pub fn read(b: &[u8]) -> anyhow::Result<(Kind, Vec<Item<'_>>)> {
         0 => Kind::Tick(stamp),
         1 => Kind::End,
         2 => Kind::Live,
+        3 => Kind::Resync(stamp),
         k => anyhow::bail!("bundle kind {k} unknown"),
     };
     let count = u64_of(take(4, "the count")?) as usize;
@@ -145,6 +151,8 @@ mod tests {
         let end = w.finish(Kind::End);
         let (k, items) = read(&end).expect("end");
         assert_eq!((k, items.len()), (Kind::End, 0), "a finished writer starts empty");
+        let (k, _) = read(&w.finish(Kind::Resync(7))).expect("resync");
+        assert_eq!(k, Kind::Resync(7));
         let e = read(&b[..b.len() - 1]).err().expect("cut").to_string();
         assert!(e.contains("cut short"), "{e}");
         let mut v2 = b.clone();

@@ -7,10 +7,16 @@
 //! one publisher, so a tick's messages and its progress arrive together and in order; what the
 //! bridge itself published is known by its publishers and never sent back. In real time there
 //! are no turns: each side sends what its services publish as it comes (`run_live`).
+//!
+//! Either bridge may be killed and restarted mid-launch ([`Keep`]): the main host's sends the
+//! tick it was in again, and the other host's answers a tick it answered before from the answer
+//! it kept; the other host's asks for the tick under way again (`Kind::Resync`), which may have
+//! gone while nobody listened. A tick's messages taken or published before the kill are not
+//! sent or published twice, so the recording is the one without the kill.
 
 use std::time::{Duration, Instant};
 
-use harvey_bus::{Bus, FdSource, Lockstep, Waiter, Wake};
+use harvey_bus::{Bus, FdSource, Waiter, Wake};
 use harvey_runtime::taps::Tap;
 use zenoh::Wait;
 use zenoh::liveliness::LivelinessToken;
@@ -18,12 +24,13 @@ use zenoh::pubsub::Publisher;
 use zenoh::qos::CongestionControl;
 
 use crate::bundle::{self, Kind};
+use crate::keep::{Keep, Ticks};
 use crate::mailbox::Mailbox;
 use crate::sinks::Sinks;
 use crate::wire::{self, Meta};
 
 /// How often a wait for the other host is reported.
-const STALL_REPORT: Duration = Duration::from_secs(5);
+pub(crate) const STALL_REPORT: Duration = Duration::from_secs(5);
 
 /// The key from one host's bridge to the other's.
 fn chain_key(namespace: &str, from: &str, to: &str) -> String {
@@ -40,18 +47,26 @@ pub struct Chain<'a> {
     pub bus: &'a Bus,
     pub taps: &'a [Box<dyn Tap>],
     pub sinks: &'a mut Sinks,
-    peer: String,
+    pub(crate) peer: String,
     out: Publisher<'static>,
-    inbox: Mailbox,
+    pub(crate) inbox: Mailbox,
     /// What this host's services published since the last bundle went out.
     pending: bundle::Writer,
+    pub(crate) keep: Keep,
+    /// Whether the other host's bridge has been heard listening on the key to it; until then a
+    /// bundle waits (at most `patience`), since one put before the sessions meet is lost.
+    met: std::cell::Cell<bool>,
+    patience: Duration,
+    /// The messages of the last answer sent (the other host): never sent again, though a
+    /// restart may find them on the taps before the checkpoint knew they were taken.
+    answered: Vec<(String, u64, u64)>,
 }
 
 impl<'a> Chain<'a> {
     pub fn new(
         session: &zenoh::Session,
         namespace: &str,
-        (host, peer): (&str, &str),
+        (host, peer, patience): (&str, &str, Duration),
         bus: &'a Bus,
         taps: &'a [Box<dyn Tap>],
         sinks: &'a mut Sinks,
@@ -64,7 +79,20 @@ impl<'a> Chain<'a> {
             .map_err(|e| anyhow::anyhow!("cannot publish {key} on Zenoh: {e}"))?;
         let mut inbox = Mailbox::new()?;
         inbox.subscribe(session, &chain_key(namespace, peer, host))?;
-        Ok(Self { bus, taps, sinks, peer: peer.to_owned(), out, inbox, pending: bundle::Writer::new() })
+        let keep = Keep::from_env()?;
+        Ok(Self {
+            bus,
+            taps,
+            sinks,
+            peer: peer.to_owned(),
+            out,
+            inbox,
+            pending: bundle::Writer::new(),
+            keep,
+            met: std::cell::Cell::new(false),
+            patience,
+            answered: Vec::new(),
+        })
     }
 
     /// What rings when the other host's bundle arrives.
@@ -72,23 +100,58 @@ impl<'a> Chain<'a> {
         self.inbox.bell()
     }
 
-    /// Sends what is pending and the messages queued on the taps stamped at most `until_ns`,
-    /// closed by `kind`.
-    fn send(&mut self, kind: Kind, until_ns: u64) -> anyhow::Result<()> {
+    /// What is pending and the messages queued on the taps stamped at most `until_ns`, closed
+    /// by `kind`, as a bundle.
+    pub(crate) fn bundle(&mut self, kind: Kind, until_ns: u64) -> anyhow::Result<zenoh::bytes::ZBytes> {
         self.collect(until_ns)?;
-        let bundle = self.pending.finish(kind);
+        Ok(self.pending.finish(kind).into())
+    }
+
+    /// Puts a bundle (or a copy of one: Zenoh's bytes are shared, not copied) on the key to the
+    /// other host, once its bridge has been heard listening there.
+    pub(crate) fn put(&self, bundle: zenoh::bytes::ZBytes) -> anyhow::Result<()> {
+        self.heard()?;
         self.out.put(bundle).wait().map_err(|e| anyhow::anyhow!("sending to host {}: {e}", self.peer))
     }
 
+    /// Waits until the other host's bridge subscribes to the key to it (once: a bridge that
+    /// restarts later asks for what it missed), or names it after `patience`.
+    fn heard(&self) -> anyhow::Result<()> {
+        let since = Instant::now();
+        while !self.met.get() {
+            let status = self.out.matching_status().wait();
+            let matching = status.map_err(|e| anyhow::anyhow!("asking Zenoh who listens: {e}"))?.matching();
+            self.met.set(matching);
+            anyhow::ensure!(
+                matching || since.elapsed() < self.patience,
+                "host {}'s bridge has not listened within {} s",
+                self.peer,
+                self.patience.as_secs()
+            );
+            if !matching {
+                std::thread::sleep(Duration::from_millis(5));
+            }
+        }
+        Ok(())
+    }
+
     /// Adds the messages queued on the taps stamped at most `until_ns` to what is pending, but
-    /// for those this bridge published itself (what came from the other host).
+    /// for those this bridge published itself (what came from the other host) and those a
+    /// predecessor took before it was killed.
     fn collect(&mut self, until_ns: u64) -> anyhow::Result<()> {
         let own = self.sinks.origins();
-        let (w, mut failed) = (&mut self.pending, None);
+        let (w, keep, mut failed) = (&mut self.pending, &mut self.keep, None);
+        let answered = &self.answered;
         for tap in self.taps {
             let fingerprint = wire::fingerprint(tap.def());
-            tap.take_owned(&|from| own.contains(&from), &mut |seq, stamp_ns, cdr| {
-                if stamp_ns <= until_ns && failed.is_none() {
+            let again =
+                |seq, stamp| answered.iter().any(|(t, q, s)| (*q, *s) == (seq, stamp) && t == tap.topic());
+            tap.take_owned(&|from| own.contains(&from), &mut |from, seq, stamp_ns, cdr| {
+                if stamp_ns <= until_ns
+                    && failed.is_none()
+                    && keep.fresh(tap.topic(), from, stamp_ns, seq)
+                    && !again(seq, stamp_ns)
+                {
                     let meta = Meta { seq, stamp_ns, fingerprint };
                     failed = w.push(tap.topic(), &meta, &cdr).err();
                 }
@@ -138,7 +201,10 @@ impl<'a> Chain<'a> {
                     .map_err(|e| anyhow::anyhow!("sending to host {}: {e}", self.peer))?;
             }
             while let Some(a) = self.inbox.next() {
-                if self.publish(&a.payload.to_bytes())? == Kind::End {
+                let bytes = a.payload.to_bytes();
+                let (kind, items) = self.read(&bytes)?;
+                self.publish(None, &items)?;
+                if kind == Kind::End {
                     return Ok(());
                 }
             }
@@ -146,7 +212,11 @@ impl<'a> Chain<'a> {
     }
 
     /// Waits for the other host's next bundle; `None` if this process is asked to stop first.
-    fn receive(&self, waiter: &Waiter, waiting_for: &str) -> anyhow::Result<Option<zenoh::bytes::ZBytes>> {
+    pub(crate) fn receive(
+        &self,
+        waiter: &Waiter,
+        waiting_for: &str,
+    ) -> anyhow::Result<Option<zenoh::bytes::ZBytes>> {
         let since = Instant::now();
         loop {
             if let Some(a) = self.inbox.next() {
@@ -165,14 +235,29 @@ impl<'a> Chain<'a> {
         }
     }
 
+    /// Notes the messages of an answer sent (or kept by a predecessor), never to send them again.
+    pub(crate) fn answered(&mut self, bundle: &[u8]) -> anyhow::Result<()> {
+        let (_, items) = bundle::read(bundle).map_err(|e| anyhow::anyhow!("the answer kept: {e}"))?;
+        self.answered.clear();
+        self.answered.extend(items.iter().map(|i| (i.topic.to_owned(), i.meta.seq, i.meta.stamp_ns)));
+        Ok(())
+    }
+
+    /// Reads a bundle from the other host.
+    pub(crate) fn read<'p>(&self, payload: &'p [u8]) -> anyhow::Result<(Kind, Vec<bundle::Item<'p>>)> {
+        bundle::read(payload).map_err(|e| anyhow::anyhow!("from host {}: {e}", self.peer))
+    }
+
     /// Publishes a bundle's messages on the bus (the taps will skip them: their publishers are
-    /// this bridge's). What this host's services published before (outside the chain's turns:
-    /// a standing request made at start-up) is kept for the next bundle first.
-    fn publish(&mut self, payload: &[u8]) -> anyhow::Result<Kind> {
-        let (kind, items) =
-            bundle::read(payload).map_err(|e| anyhow::anyhow!("from host {}: {e}", self.peer))?;
+    /// this bridge's), but for those of the bundle for `tick` a killed predecessor published. What
+    /// this host's services published before (outside the chain's turns: a standing request made
+    /// at start-up) is kept for the next bundle first.
+    pub(crate) fn publish(&mut self, tick: Option<u64>, items: &[bundle::Item]) -> anyhow::Result<()> {
         self.collect(u64::MAX)?;
-        for item in &items {
+        for (i, item) in items.iter().enumerate() {
+            if tick.is_some_and(|t| !self.keep.due(t, i)) {
+                continue;
+            }
             let sink = self.sinks.get(self.bus, item.topic)?;
             anyhow::ensure!(
                 sink.fingerprint() == item.meta.fingerprint,
@@ -184,75 +269,53 @@ impl<'a> Chain<'a> {
             );
             sink.publish(&item.meta, item.cdr)
                 .map_err(|e| anyhow::anyhow!("{} from host {}: {e}", item.topic, self.peer))?;
+            if let Some(t) = tick {
+                self.keep.published(t, i)?;
+            }
         }
-        Ok(kind)
+        Ok(())
     }
 
     /// The stand-in's turn for `tick`: this host's messages out, the other host's in. False if
-    /// asked to stop while waiting.
+    /// asked to stop while waiting. An answer to an earlier tick is one already published, sent
+    /// again by a restarted bridge on the other host; when that bridge asks for the tick after
+    /// its last, the tick goes again.
     pub fn stand_in_turn(&mut self, waiter: &Waiter, tick: u64) -> anyhow::Result<bool> {
-        self.send(Kind::Tick(tick), tick)?;
-        let Some(reply) = self.receive(waiter, &format!("its share of tick {:.3} s", tick as f64 / 1e9))?
-        else {
-            return Ok(false);
-        };
-        match self.publish(&reply.to_bytes())? {
-            Kind::Tick(t) if t == tick => Ok(true),
-            other => anyhow::bail!("host {} answered tick {tick} with {other:?}", self.peer),
+        let sent = self.bundle(Kind::Tick(tick), tick)?;
+        self.put(sent.clone())?;
+        let waiting_for = format!("its share of tick {:.3} s", tick as f64 / 1e9);
+        loop {
+            let Some(reply) = self.receive(waiter, &waiting_for)? else { return Ok(false) };
+            let bytes = reply.to_bytes();
+            match self.read(&bytes)? {
+                (Kind::Tick(t), items) if t == tick => {
+                    self.publish(Some(tick), &items)?;
+                    self.keep.save(Ticks { done: tick, started: None })?;
+                    return Ok(true);
+                }
+                (Kind::Tick(t), _) if t < tick => {
+                    tracing::debug!(tick = t, "an answer published before, again")
+                }
+                (Kind::Resync(done), _) if done < tick => {
+                    tracing::warn!(
+                        host = self.peer,
+                        "host {}'s bridge was restarted after tick {:.3} s: tick {:.3} s sent again",
+                        self.peer,
+                        done as f64 / 1e9,
+                        tick as f64 / 1e9
+                    );
+                    self.put(sent.clone())?;
+                }
+                (Kind::Resync(_), _) => {}
+                (other, _) => anyhow::bail!("host {} answered tick {tick} with {other:?}", self.peer),
+            }
         }
     }
 
     /// Tells the other host the launch is ending.
     pub fn end(&mut self) -> anyhow::Result<()> {
-        self.send(Kind::End, 0)
-    }
-
-    /// The other host's clock master: until the main host ends the launch (or this process is
-    /// stopped), each tick that comes is published, run through this host's chain and answered.
-    pub fn run_segment(
-        &mut self,
-        session: &zenoh::Session,
-        namespace: &str,
-        host: &str,
-        lockstep: &Lockstep,
-    ) -> anyhow::Result<()> {
-        let waiter = Waiter::new()?;
-        let bell = FdSource::new(self.inbox.bell())?;
-        let _a = (waiter.attach(lockstep.predecessor())?, waiter.attach(&bell)?);
-        // The supervisor starts the chain once every service here is ready (tick 0 of the tail).
-        let mut done: Option<u64> = None;
-        while done.is_none() {
-            if waiter.wait(Some(STALL_REPORT))? == Wake::Shutdown {
-                return Ok(());
-            }
-            lockstep.finished(|t| done = Some(t))?;
-        }
-        let _ready = self.declare_ready(session, namespace, host)?;
-        loop {
-            let Some(payload) = self.receive(&waiter, "the next tick")? else { return Ok(()) };
-            let tick = match self.publish(&payload.to_bytes())? {
-                Kind::End => return Ok(()),
-                Kind::Tick(t) => t,
-                Kind::Live => anyhow::bail!(
-                    "host {} runs in real time, this host deterministic: start both shares with --realtime or both without",
-                    self.peer
-                ),
-            };
-            lockstep.finish(tick)?;
-            let since = Instant::now();
-            while done.is_none_or(|d| d < tick) {
-                match waiter.wait(Some(STALL_REPORT))? {
-                    Wake::Shutdown => return Ok(()),
-                    Wake::Timeout => tracing::warn!(
-                        waited_s = since.elapsed().as_secs(),
-                        "this host's chain has not finished tick {tick}"
-                    ),
-                    Wake::Ready => {}
-                }
-                lockstep.finished(|t| done = Some(done.map_or(t, |d| d.max(t))))?;
-            }
-            self.send(Kind::Tick(tick), tick)?;
-        }
+        let b = self.bundle(Kind::End, 0)?;
+        self.put(b)
     }
 }
 

@@ -139,7 +139,7 @@ impl Exporter {
         let (mut total, mut left_out) = (0, 0);
         for (tap, out) in taps.iter().zip(self.outs.iter_mut()) {
             let mut failed = None;
-            let n = tap.take_owned(&|_| false, &mut |seq, stamp_ns, cdr| {
+            let n = tap.take_owned(&|_| false, &mut |_, seq, stamp_ns, cdr| {
                 if failed.is_some() {
                     return;
                 }

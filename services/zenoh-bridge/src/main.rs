@@ -16,9 +16,11 @@ mod bundle;
 mod chain;
 mod export;
 mod import;
+mod keep;
 mod mailbox;
 mod peers;
 mod ros2;
+mod segment;
 mod session;
 mod sinks;
 mod wire;
@@ -152,10 +154,10 @@ fn run_chain(
     sinks: &mut sinks::Sinks,
 ) -> anyhow::Result<()> {
     let taps = harvey_runtime::taps::open_all(bus)?;
-    let mut chain = chain::Chain::new(session, &args.namespace, (&args.host, peer), bus, &taps, sinks)?;
+    let wait = Duration::from_secs(args.wait_s);
+    let mut chain = chain::Chain::new(session, &args.namespace, (&args.host, peer, wait), bus, &taps, sinks)?;
     let lockstep = pace.lockstep();
     tracing::info!(host = args.host, peer, ?role, lockstep = lockstep.is_some(), listen = ?args.listen, connect = ?args.connect, "carrying every topic to the other host over Zenoh");
-    let wait = Duration::from_secs(args.wait_s);
     let Some(lockstep) = lockstep else {
         let _ready = chain.declare_ready(session, &args.namespace, &args.host)?;
         if role == Role::StandIn {
