@@ -2,7 +2,8 @@
 //! `harvey-zenoh-bridge` processes over `tcp/127.0.0.1:<free port>`: messages and camera frames
 //! published in one domain arrive in the other exactly (fields, sequence numbers, stamps,
 //! every pixel), frames in loaned shared memory; an importing bridge whose topics nobody
-//! exports gives up naming them; a bad endpoint is named.
+//! exports gives up naming them; a bad endpoint is named. Launches split over two hosts:
+//! `tests/zenoh_split.rs`.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
@@ -22,11 +23,6 @@ impl Drop for Bridge {
         common::signal(&self.0, libc::SIGTERM);
         common::wait_exit(&mut self.0, Duration::from_secs(10));
     }
-}
-
-fn free_port() -> u16 {
-    let l = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
-    l.local_addr().expect("addr").port()
 }
 
 fn bridge(prefix: &str, args: &[&str]) -> Command {
@@ -51,7 +47,7 @@ fn until<T>(limit: Duration, mut poke: impl FnMut(), mut got: impl FnMut() -> Op
 #[test]
 fn messages_and_frames_cross_from_one_domain_to_another_exactly() {
     let (pa, pb) = (common::unique_prefix("zba"), common::unique_prefix("zbb"));
-    let port = free_port();
+    let port = common::free_port();
     let at = format!("tcp/127.0.0.1:{port}");
     let carried = "odometry,camera/frame";
     let a = Bridge(
@@ -111,7 +107,7 @@ fn messages_and_frames_cross_from_one_domain_to_another_exactly() {
 #[test]
 fn an_import_nobody_exports_and_a_bad_endpoint_are_named() {
     let prefix = common::unique_prefix("zbn");
-    let at = format!("tcp/127.0.0.1:{}", free_port());
+    let at = format!("tcp/127.0.0.1:{}", common::free_port());
     let mut c = bridge(&prefix, &["--import", "ums/map", "--zenoh-listen", &at, "--wait-s", "1"])
         .stderr(Stdio::piped())
         .spawn()
@@ -128,209 +124,4 @@ fn an_import_nobody_exports_and_a_bad_endpoint_are_named() {
     assert!(!out.status.success());
     assert!(err.contains("--zenoh-listen udp/127.0.0.1:7447: not `tcp/HOST:PORT`"), "{err}");
     harvey_bus::retire_domain(&prefix).expect("retire");
-}
-
-/// `harvey diff`'s verdict on two recordings.
-fn diff(a: &std::path::Path, b: &std::path::Path) -> String {
-    let out = common::harvey(&["diff", a.to_str().expect("utf8"), b.to_str().expect("utf8")])
-        .output()
-        .expect("diff");
-    String::from_utf8_lossy(&out.stdout).into_owned()
-}
-
-/// `missions/default-split.toml` run over two bus domains joined only by the two bridges: the
-/// gpu host's share started first, then the main host's, which must reach the goal and end the
-/// other's launch too. Returns the main host's run folder (to remove) after checking both
-/// domains' shared memory is gone.
-fn run_split(tag: &str, how: &[&str]) -> common::Scratch {
-    let mission = "missions/default-split.toml";
-    let (pa, pb) = (common::unique_prefix(&format!("{tag}a")), common::unique_prefix(&format!("{tag}b")));
-    let (main_dir, gpu_dir) =
-        (common::scratch(&format!("{tag}-main")), common::scratch(&format!("{tag}-gpu")));
-    let at = format!("tcp/127.0.0.1:{}", free_port());
-    let mut gpu =
-        common::harvey(&["launch", mission, "--host", "gpu", "--prefix", &pb, "--zenoh-listen", &at])
-            .args(how)
-            .args(["--run-dir", gpu_dir.to_str().expect("utf8")])
-            .stdout(Stdio::null())
-            .spawn()
-            .expect("the gpu host's share");
-    let main = common::harvey(&["run", mission, "--host", "main", "--prefix", &pa, "--zenoh-connect", &at])
-        .args(how)
-        .args(["--run-dir", main_dir.to_str().expect("utf8")])
-        .output()
-        .expect("the main host's share");
-    let stdout = String::from_utf8_lossy(&main.stdout);
-    assert!(main.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&main.stderr));
-    assert!(stdout.contains("goal reached"), "{stdout}");
-    assert!(
-        common::wait_exit(&mut gpu, Duration::from_secs(60)).success(),
-        "the gpu host's launch ends cleanly"
-    );
-    for p in [&pa, &pb] {
-        assert_eq!(common::shm_leftovers(p), Vec::<String>::new());
-    }
-    std::fs::remove_dir_all(&gpu_dir).ok();
-    main_dir
-}
-
-#[test]
-fn a_mission_split_over_two_hosts_records_what_it_records_on_one() {
-    let main_dir = run_split("zsplit", &[]);
-    let one = common::run_mission("missions/default-split.toml", "zenoh-split-one");
-    assert!(one.status.success(), "{}", one.stdout);
-    let verdict = diff(&one.dir.join("run.mcap"), &main_dir.join("run.mcap"));
-    assert!(verdict.starts_with("identical"), "split over two hosts against one host: {verdict}");
-    std::fs::remove_dir_all(&main_dir).ok();
-}
-
-#[test]
-fn a_mission_split_over_two_hosts_runs_in_real_time_too() {
-    let main_dir = run_split("zlive", &["--realtime"]);
-    // The gpu host's services were heard on the main host: the vision workers' detections and
-    // the UMS's maps, on about every frame and tick of the 26 s run.
-    let recording = harvey_recording::Recording::open(&main_dir.join("run.mcap")).expect("recording");
-    let (mut detections, mut maps) = (0, 0);
-    for m in recording.messages().expect("messages") {
-        match m.expect("reads").topic() {
-            "vision/detections" => detections += 1,
-            "ums/map" => maps += 1,
-            _ => {}
-        }
-    }
-    assert!(detections > 200 && maps > 400, "{detections} detections, {maps} maps from host gpu");
-    std::fs::remove_dir_all(&main_dir).ok();
-}
-
-/// Waits until `sim/truth` in the bus domain `prefix` passes `at_ns` of the run's time, then
-/// SIGKILLs the domain's Zenoh bridge; returns its pid, or `None` if the launch ended first.
-fn kill_bridge_when(prefix: &str, at_ns: u64, running: impl Fn() -> bool) -> Option<i32> {
-    let bridge = || {
-        harvey_bus::live_nodes(prefix)
-            .unwrap_or_default()
-            .into_iter()
-            .find(|n| n.alive && n.name == "zenoh-bridge")
-            .map(|n| n.pid)
-    };
-    while bridge().is_none() {
-        if !running() {
-            return None;
-        }
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    let bus = Bus::join_with_prefix("test-killer", prefix).expect("bus");
-    let truth = bus.subscriber(topics::SIM_TRUTH).expect("sim/truth");
-    loop {
-        if truth.latest().expect("truth").is_some_and(|t| t.header.stamp_ns >= at_ns) {
-            break;
-        }
-        if !running() {
-            return None;
-        }
-        std::thread::sleep(Duration::from_millis(2));
-    }
-    let pid = bridge()?;
-    // SAFETY: kill(2) on a process of this test's launch.
-    unsafe { libc::kill(pid, libc::SIGKILL) };
-    Some(pid)
-}
-
-/// `default-split` over two domains with the bridges SIGKILLed when the run's time passes
-/// `kills` (`(host, ns)`, in time order); checks both shares end well, each killed bridge was
-/// restarted by its host's supervisor, and nothing is left in shared memory. The main host's run
-/// folder.
-fn split_with_kills(tag: &str, kills: &[(&str, u64)]) -> common::Scratch {
-    let mission = "missions/default-split.toml";
-    let (pa, pb) = (common::unique_prefix(&format!("{tag}a")), common::unique_prefix(&format!("{tag}b")));
-    let (main_dir, gpu_dir) =
-        (common::scratch(&format!("{tag}-main")), common::scratch(&format!("{tag}-gpu")));
-    let at = format!("tcp/127.0.0.1:{}", free_port());
-    let log = |dir: &std::path::Path, name: &str| std::fs::File::create(dir.join(name)).expect("log");
-    let mut gpu =
-        common::harvey(&["launch", mission, "--host", "gpu", "--prefix", &pb, "--zenoh-listen", &at])
-            .args(["--run-dir", gpu_dir.to_str().expect("utf8")])
-            .stdout(Stdio::null())
-            .stderr(log(&gpu_dir, "stderr.log"))
-            .spawn()
-            .expect("the gpu host's share");
-    let mut main =
-        common::harvey(&["run", mission, "--host", "main", "--prefix", &pa, "--zenoh-connect", &at])
-            .args(["--run-dir", main_dir.to_str().expect("utf8")])
-            .stdout(log(&main_dir, "stdout.log"))
-            .stderr(log(&main_dir, "stderr.log"))
-            .spawn()
-            .expect("the main host's share");
-    let main_pid = main.id();
-    // Until `harvey run` exits (a zombie until waited for).
-    let running =
-        move || std::fs::read_to_string(format!("/proc/{main_pid}/stat")).is_ok_and(|s| !s.contains(") Z "));
-    let killed: Vec<Option<i32>> = kills
-        .iter()
-        .map(|&(host, at_ns)| kill_bridge_when(if host == "main" { &pa } else { &pb }, at_ns, running))
-        .collect();
-    let status = common::wait_exit(&mut main, Duration::from_secs(300));
-    let read = |p: std::path::PathBuf| std::fs::read_to_string(p).expect("log");
-    let (stdout, stderr) = (read(main_dir.join("stdout.log")), read(main_dir.join("stderr.log")));
-    let gpu_log = read(gpu_dir.join("stderr.log"));
-    assert!(status.success() && stdout.contains("goal reached"), "{stdout}\n{stderr}\n--- gpu:\n{gpu_log}");
-    assert!(common::wait_exit(&mut gpu, Duration::from_secs(60)).success(), "{gpu_log}");
-    assert!(killed.iter().all(Option::is_some), "every kill landed mid-run: {kills:?} {killed:?}");
-    for (host, _) in kills {
-        let log = if *host == "main" { &stderr } else { &gpu_log };
-        let said = |what: &str| log.lines().any(|l| l.contains(what) && l.contains("service=zenoh-bridge"));
-        assert!(
-            said("exited with SIGKILL: restart") && said("restarted"),
-            "the {host} host's supervisor restarted its killed bridge:\n{log}"
-        );
-    }
-    if kills.iter().any(|(h, _)| *h == "gpu") {
-        assert!(gpu_log.contains("restarted: asking host main for the tick after"), "{gpu_log}");
-    }
-    for p in [&pa, &pb] {
-        assert_eq!(common::shm_leftovers(p), Vec::<String>::new());
-    }
-    main_dir
-}
-
-/// Item 5 of issue 16: each host's bridge SIGKILLed mid-run, in either order and at times that
-/// land in different places of its turn, is restarted by its supervisor and the chain resumes
-/// where it was: the mission reaches its goal and the recording is the one the mission makes on
-/// one host, every time.
-#[test]
-fn a_bridge_killed_mid_run_on_either_host_comes_back_and_the_recording_is_identical() {
-    let s = 1_000_000_000;
-    let one = common::run_mission("missions/default-split.toml", "zenoh-kill-one");
-    assert!(one.status.success(), "{}", one.stdout);
-    let plans: [&[(&str, u64)]; 3] = [
-        &[("main", 6 * s), ("gpu", 14 * s)],
-        &[("gpu", 5 * s + 230_000_000), ("main", 11 * s + 770_000_000)],
-        &[("main", 9 * s + 310_000_000), ("gpu", 9 * s + 960_000_000), ("main", 20 * s)],
-    ];
-    for (i, kills) in plans.iter().enumerate() {
-        let main_dir = split_with_kills(&format!("zk{i}"), kills);
-        let verdict = diff(&one.dir.join("run.mcap"), &main_dir.join("run.mcap"));
-        assert!(verdict.starts_with("identical"), "kills {kills:?} against one host: {verdict}");
-    }
-}
-
-#[test]
-fn a_host_that_never_joins_is_named() {
-    let dir = common::scratch("zenoh-split-alone");
-    let prefix = common::unique_prefix("zsn");
-    let at = format!("tcp/127.0.0.1:{}", free_port());
-    let out = common::harvey(&["run", "missions/default-split.toml", "--host", "main", "--prefix", &prefix])
-        .args(["--zenoh-listen", &at, "--run-dir", dir.to_str().expect("utf8")])
-        .output()
-        .expect("runs");
-    let all = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
-    assert!(!out.status.success(), "{all}");
-    assert!(all.contains("host gpu never joined"), "{all}");
-    let unknown =
-        common::harvey(&["launch", "missions/default-split.toml", "--host", "tpu", "--zenoh-listen", &at])
-            .output()
-            .expect("runs");
-    let err = String::from_utf8_lossy(&unknown.stderr);
-    assert!(!unknown.status.success() && err.contains("none on `tpu`"), "{err}");
-    assert_eq!(common::shm_leftovers(&prefix), Vec::<String>::new());
-    std::fs::remove_dir_all(&dir).ok();
 }

@@ -73,6 +73,13 @@ impl Drop for Scratch {
     }
 }
 
+/// A TCP port on loopback that was free a moment ago (network tests use loopback only).
+#[allow(dead_code)] // not every test binary uses the network
+pub fn free_port() -> u16 {
+    let l = std::net::TcpListener::bind("127.0.0.1:0").expect("bind");
+    l.local_addr().expect("addr").port()
+}
+
 /// Shared-memory objects of a bus prefix still in /dev/shm.
 pub fn shm_leftovers(prefix: &str) -> Vec<String> {
     std::fs::read_dir("/dev/shm")

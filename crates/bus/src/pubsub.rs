@@ -67,7 +67,7 @@ fn open_service<T: Message>(
 
 /// Which publisher sent a message: a bridge takes what it published itself off its own
 /// subscriptions by this, never sending it back where it came from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Origin(pub(crate) iceoryx2::identifiers::UniquePublisherId);
 
 /// The publisher's id in hex, unique on this host (a restarted service's publishers get new ones).

@@ -16,7 +16,7 @@
 
 use std::time::{Duration, Instant};
 
-use harvey_bus::{Bus, FdSource, Waiter, Wake};
+use harvey_bus::{Bus, Waiter, Wake};
 use harvey_runtime::taps::Tap;
 use zenoh::Wait;
 use zenoh::liveliness::LivelinessToken;
@@ -37,11 +37,6 @@ fn chain_key(namespace: &str, from: &str, to: &str) -> String {
     format!("{namespace}/@chain/v{}/{from}/{to}", wire::LAYOUT)
 }
 
-/// The liveliness token of a bridge whose chain has started.
-fn ready_key(namespace: &str, host: &str) -> String {
-    format!("{namespace}/@chain/v{}/ready/{host}", wire::LAYOUT)
-}
-
 /// One host's end of the chain between two hosts.
 pub struct Chain<'a> {
     pub bus: &'a Bus,
@@ -57,8 +52,8 @@ pub struct Chain<'a> {
     /// bundle waits (at most `patience`), since one put before the sessions meet is lost.
     met: std::cell::Cell<bool>,
     patience: Duration,
-    /// The messages of the last answer sent (the other host): never sent again, though a
-    /// restart may find them on the taps before the checkpoint knew they were taken.
+    /// The messages of the answer a predecessor kept (the other host), until the next bundle:
+    /// never sent again, though the taps may hand them over before the checkpoint knew them taken.
     answered: Vec<(String, u64, u64)>,
 }
 
@@ -104,6 +99,8 @@ impl<'a> Chain<'a> {
     /// by `kind`, as a bundle.
     pub(crate) fn bundle(&mut self, kind: Kind, until_ns: u64) -> anyhow::Result<zenoh::bytes::ZBytes> {
         self.collect(until_ns)?;
+        self.keep.bundle_left();
+        self.answered.clear();
         Ok(self.pending.finish(kind).into())
     }
 
@@ -133,6 +130,12 @@ impl<'a> Chain<'a> {
             }
         }
         Ok(())
+    }
+
+    /// Whether this host's services published anything since the last bundle (taken now).
+    pub(crate) fn has_news(&mut self) -> anyhow::Result<bool> {
+        self.collect(u64::MAX)?;
+        Ok(!self.pending.is_empty())
     }
 
     /// Adds the messages queued on the taps stamped at most `until_ns` to what is pending, but
@@ -169,53 +172,18 @@ impl<'a> Chain<'a> {
     ) -> anyhow::Result<LivelinessToken> {
         session
             .liveliness()
-            .declare_token(ready_key(namespace, host))
+            .declare_token(crate::peers::ready_key(namespace, host))
             .wait()
             .map_err(|e| anyhow::anyhow!("declaring this host ready on Zenoh: {e}"))
     }
 
-    /// In real time: whatever this host's services publish goes to the other host as it comes,
-    /// and what comes is published here, until the main host ends the launch (a `Live` bundle
-    /// per wake-up; the order of each topic's messages is kept). The main host's bridge tells
-    /// the other it ends when it is stopped.
-    pub fn run_live(&mut self, main_side: bool) -> anyhow::Result<()> {
-        let waiter = Waiter::new()?;
-        let bell = FdSource::new(self.inbox.bell())?;
-        let mut attached = vec![waiter.attach(&bell)?];
-        for t in self.taps {
-            attached.push(waiter.attach(t.waitable())?);
-        }
-        loop {
-            if waiter.wait(Some(STALL_REPORT))? == Wake::Shutdown {
-                if main_side {
-                    self.end()?;
-                }
-                return Ok(());
-            }
-            self.collect(u64::MAX)?;
-            if !self.pending.is_empty() {
-                let bundle = self.pending.finish(Kind::Live);
-                self.out
-                    .put(bundle)
-                    .wait()
-                    .map_err(|e| anyhow::anyhow!("sending to host {}: {e}", self.peer))?;
-            }
-            while let Some(a) = self.inbox.next() {
-                let bytes = a.payload.to_bytes();
-                let (kind, items) = self.read(&bytes)?;
-                self.publish(None, &items)?;
-                if kind == Kind::End {
-                    return Ok(());
-                }
-            }
-        }
-    }
-
-    /// Waits for the other host's next bundle; `None` if this process is asked to stop first.
+    /// Waits for the other host's next bundle, sending `again` every few seconds meanwhile;
+    /// `None` if this process is asked to stop first.
     pub(crate) fn receive(
         &self,
         waiter: &Waiter,
         waiting_for: &str,
+        again: &zenoh::bytes::ZBytes,
     ) -> anyhow::Result<Option<zenoh::bytes::ZBytes>> {
         let since = Instant::now();
         loop {
@@ -224,18 +192,22 @@ impl<'a> Chain<'a> {
             }
             match waiter.wait(Some(STALL_REPORT))? {
                 Wake::Shutdown => return Ok(None),
-                Wake::Timeout => tracing::warn!(
-                    host = self.peer,
-                    waited_s = since.elapsed().as_secs(),
-                    "waiting for host {} ({waiting_for})",
-                    self.peer
-                ),
+                Wake::Timeout => {
+                    tracing::warn!(
+                        host = self.peer,
+                        waited_s = since.elapsed().as_secs(),
+                        "waiting for host {} ({waiting_for}): asking again",
+                        self.peer
+                    );
+                    // What was last sent goes again: every bundle can be taken twice, and one
+                    // lost while a link came back would otherwise hold both hosts for good.
+                    self.put(again.clone())?;
+                }
                 Wake::Ready => {}
             }
         }
     }
-
-    /// Notes the messages of an answer sent (or kept by a predecessor), never to send them again.
+    /// Notes the messages of the answer a predecessor kept, not to send them again.
     pub(crate) fn answered(&mut self, bundle: &[u8]) -> anyhow::Result<()> {
         let (_, items) = bundle::read(bundle).map_err(|e| anyhow::anyhow!("the answer kept: {e}"))?;
         self.answered.clear();
@@ -285,7 +257,7 @@ impl<'a> Chain<'a> {
         self.put(sent.clone())?;
         let waiting_for = format!("its share of tick {:.3} s", tick as f64 / 1e9);
         loop {
-            let Some(reply) = self.receive(waiter, &waiting_for)? else { return Ok(false) };
+            let Some(reply) = self.receive(waiter, &waiting_for, &sent)? else { return Ok(false) };
             let bytes = reply.to_bytes();
             match self.read(&bytes)? {
                 (Kind::Tick(t), items) if t == tick => {
@@ -316,28 +288,5 @@ impl<'a> Chain<'a> {
     pub fn end(&mut self) -> anyhow::Result<()> {
         let b = self.bundle(Kind::End, 0)?;
         self.put(b)
-    }
-}
-
-/// Waits (at most `wait`) until the other host's bridge has started its chain, or names it.
-pub fn await_peer(
-    session: &zenoh::Session,
-    namespace: &str,
-    peer: &str,
-    wait: Duration,
-) -> anyhow::Result<()> {
-    let key = ready_key(namespace, peer);
-    let start = Instant::now();
-    loop {
-        if !crate::peers::live_keys(session, &key)?.is_empty() {
-            return Ok(());
-        }
-        anyhow::ensure!(
-            start.elapsed() < wait,
-            "host {peer} never joined within {} s: start its share (`harvey launch FILE --host {peer}` with \
-             --zenoh-connect or --zenoh-listen pointing here)",
-            wait.as_secs()
-        );
-        std::thread::sleep(Duration::from_millis(100));
     }
 }

@@ -1,20 +1,23 @@
 //! What a chain bridge keeps across its own restart (`docs/zenoh.md`), in the supervisor's state
 //! folder as every restartable party does (`docs/reliability.md`): the last tick whose share it
-//! finished and the messages it had taken off each publisher (`zenoh-bridge.ckpt`), how far it
-//! got publishing a bundle from the other host (`zenoh-bridge-sent.ckpt`), and, on the other
-//! host, the last answer it sent, which it sends again if the main host asks for that tick again
-//! (`zenoh-bridge-answer.bin`: the tick, a CRC-32 and the bundle; written aside and renamed).
+//! finished and the newest message it had taken off each publisher as of the last bundle that
+//! left (`zenoh-bridge.ckpt`), how far it got publishing a bundle from the other host
+//! (`zenoh-bridge-sent.ckpt`), and, on the other host, the last answer it sent, which it sends
+//! again if the main host asks for that tick again (`zenoh-bridge-answer.bin`: the tick, a CRC-32
+//! and the bundle; written aside and renamed).
 
+use std::collections::HashMap;
 use std::path::PathBuf;
 
 use harvey_bus::Origin;
-use harvey_runtime::{Resume, STATE_DIR_ENV, Sent};
+use harvey_runtime::{Checkpoint, Marks, STATE_DIR_ENV, Sent};
 use serde::{Deserialize, Serialize};
 
 /// The bridge's service name under the supervisor: its files' names.
 const SERVICE: &str = "zenoh-bridge";
-/// Bound on the checkpoint: the ticks and one mark per topic and publisher (tens of them).
-const SLOT_BYTES: usize = 64 << 10;
+/// Bound on the checkpoint: the ticks and a mark per topic and publisher, some 70 bytes each
+/// (a restarted service's publishers add theirs: thousands of restarts fit).
+const SLOT_BYTES: usize = 1 << 20;
 /// The key under which a bundle's published messages are noted: (tick, index in the bundle).
 const BUNDLE: &str = "bundle";
 
@@ -30,7 +33,18 @@ pub struct Ticks {
 
 /// The bridge's kept state.
 pub struct Keep {
-    resume: Resume<Ticks>,
+    checkpoint: Option<Checkpoint>,
+    ticks: Ticks,
+    /// Per topic and publisher, the newest message taken (into a bundle, sent or not).
+    taken: Marks,
+    /// `taken` as of the last bundle that left: what is saved, so that a message taken into a
+    /// bundle that a kill kept from leaving is taken again.
+    left: Marks,
+    resumed: bool,
+    /// Real time: nothing is marked (a restart there loses what was under way anyway).
+    live: bool,
+    /// `topic@publisher` keys, made once per publisher.
+    keys: HashMap<(&'static str, Origin), String>,
     sent: Sent,
     answer: Option<PathBuf>,
 }
@@ -39,27 +53,47 @@ impl Keep {
     /// What a predecessor left, or a fresh start; nothing is kept when the bridge runs outside
     /// a supervisor.
     pub fn from_env() -> anyhow::Result<Self> {
-        let resume = Resume::from_env(SERVICE, SLOT_BYTES, Ticks::default)?;
+        let mut checkpoint = Checkpoint::from_env(SERVICE, SLOT_BYTES)?;
+        let saved = checkpoint.as_mut().map(|c| c.load::<(Ticks, Marks)>()).transpose()?.flatten();
+        let resumed = saved.is_some();
+        let (ticks, taken) = saved.unwrap_or_default();
         let sent = Sent::from_env(SERVICE)?;
         let answer =
             std::env::var_os(STATE_DIR_ENV).map(|d| PathBuf::from(d).join(format!("{SERVICE}-answer.bin")));
-        Ok(Self { resume, sent, answer })
+        let left = taken.clone();
+        Ok(Self { checkpoint, ticks, taken, left, resumed, live: false, keys: HashMap::new(), sent, answer })
     }
 
     /// Whether a predecessor's state was found: this bridge was restarted mid-launch.
     pub fn resumed(&self) -> bool {
-        self.resume.resumed()
+        self.resumed
     }
 
-    pub fn ticks(&mut self) -> Ticks {
-        *self.resume.state()
+    pub fn ticks(&self) -> Ticks {
+        self.ticks
+    }
+
+    /// Real time: nothing is marked or kept.
+    pub fn go_live(&mut self) {
+        self.live = true;
     }
 
     /// Whether a message taken off this host's bus is news (and notes it taken): a restarted
     /// bridge is handed every publisher's newest message again. Marked per publisher, since
     /// several publish on `rosout` and `tf` with numbers of their own.
-    pub fn fresh(&mut self, topic: &str, from: Origin, stamp_ns: u64, seq: u64) -> bool {
-        self.resume.fresh(&format!("{topic}@{from}"), stamp_ns, seq)
+    pub fn fresh(&mut self, topic: &'static str, from: Origin, stamp_ns: u64, seq: u64) -> bool {
+        if self.live {
+            return true;
+        }
+        let key = self.keys.entry((topic, from)).or_insert_with(|| format!("{topic}@{from}"));
+        self.taken.fresh(key, stamp_ns, seq)
+    }
+
+    /// A bundle with what was taken so far is leaving.
+    pub fn bundle_left(&mut self) {
+        if !self.live {
+            self.left.clone_from(&self.taken);
+        }
     }
 
     /// Whether message `index` of the other host's bundle for `tick` still has to be published.
@@ -75,8 +109,11 @@ impl Keep {
     /// Saves where the chain stands with what was taken (before the tick is reported done or
     /// the answer leaves).
     pub fn save(&mut self, ticks: Ticks) -> anyhow::Result<()> {
-        *self.resume.state() = ticks;
-        Ok(self.resume.tick_done()?)
+        self.ticks = ticks;
+        match self.checkpoint.as_mut() {
+            Some(c) => Ok(c.save(&(&self.ticks, &self.left))?),
+            None => Ok(()),
+        }
     }
 
     /// Keeps the answer for `tick` (the other host), before it is sent.

@@ -17,6 +17,7 @@ mod chain;
 mod export;
 mod import;
 mod keep;
+mod live;
 mod mailbox;
 mod peers;
 mod ros2;
@@ -161,7 +162,7 @@ fn run_chain(
     let Some(lockstep) = lockstep else {
         let _ready = chain.declare_ready(session, &args.namespace, &args.host)?;
         if role == Role::StandIn {
-            chain::await_peer(session, &args.namespace, peer, wait)?;
+            peers::await_peer(session, &args.namespace, peer, wait)?;
         }
         harvey_runtime::notify_ready()?;
         return chain.run_live(role == Role::StandIn);
@@ -170,17 +171,22 @@ fn run_chain(
         harvey_runtime::notify_ready()?;
         return chain.run_segment(session, &args.namespace, &args.host, lockstep);
     }
-    chain::await_peer(session, &args.namespace, peer, wait)?;
+    peers::await_peer(session, &args.namespace, peer, wait)?;
     let waiter = Waiter::new()?;
     let _attached = pace.attach(&waiter, &[])?;
     let turn_waiter = Waiter::new()?;
     let bell = FdSource::new(chain.bell())?;
     let _bell = turn_waiter.attach(&bell)?;
     harvey_runtime::notify_ready()?;
+    // A restarted bridge may be granted a tick twice (the supervisor's grant and its
+    // predecessor's progress, if that came after this process subscribed): the turn is taken once.
+    let mut last_turn = None;
     loop {
         match pace.next(&waiter, Some(REPORT_EVERY))? {
             Step::Stop => break,
+            Step::Go(Some(tick)) if last_turn == Some(tick) => continue,
             Step::Go(Some(tick)) => {
+                last_turn = Some(tick);
                 if !chain.stand_in_turn(&turn_waiter, tick)? {
                     break;
                 }

@@ -71,3 +71,31 @@ pub fn await_exporters(
         std::thread::sleep(Duration::from_millis(100));
     }
 }
+
+/// The liveliness token of a bridge whose chain has started.
+pub fn ready_key(namespace: &str, host: &str) -> String {
+    format!("{namespace}/@chain/v{}/ready/{host}", wire::LAYOUT)
+}
+
+/// Waits (at most `wait`) until the other host's bridge has started its chain, or names it.
+pub fn await_peer(
+    session: &zenoh::Session,
+    namespace: &str,
+    peer: &str,
+    wait: Duration,
+) -> anyhow::Result<()> {
+    let key = ready_key(namespace, peer);
+    let start = Instant::now();
+    loop {
+        if !live_keys(session, &key)?.is_empty() {
+            return Ok(());
+        }
+        anyhow::ensure!(
+            start.elapsed() < wait,
+            "host {peer} never joined within {} s: start its share (`harvey launch FILE --host {peer}` with \
+             --zenoh-connect or --zenoh-listen pointing here)",
+            wait.as_secs()
+        );
+        std::thread::sleep(Duration::from_millis(100));
+    }
+}

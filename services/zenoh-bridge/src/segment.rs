@@ -41,15 +41,20 @@ impl Chain<'_> {
         let mut at = Place { ticks: self.keep.ticks(), answer, tail: None };
         let resumed = self.keep.resumed();
         // The supervisor starts the chain once every service here is ready (tick 0 of the tail).
-        if !resumed && !self.await_tail(&waiter, lockstep, &mut at, 0)? {
-            return Ok(());
+        if !resumed {
+            if !self.await_tail(&waiter, lockstep, &mut at, 0)? {
+                return Ok(());
+            }
+            // From here on a successor is a restart: it asks for the tick under way.
+            self.keep.save(at.ticks)?;
         }
         let _ready = self.declare_ready(session, namespace, host)?;
         if resumed && !self.rejoin(&waiter, lockstep, &mut at)? {
             return Ok(());
         }
         loop {
-            let Some(payload) = self.receive(&waiter, "the next tick")? else { return Ok(()) };
+            let again = bundle::Writer::new().finish(Kind::Resync(at.ticks.done)).into();
+            let Some(payload) = self.receive(&waiter, "the next tick", &again)? else { return Ok(()) };
             let bytes = payload.to_bytes();
             let (kind, items) = self.read(&bytes)?;
             let tick = match kind {
@@ -109,9 +114,7 @@ impl Chain<'_> {
     /// Sends this host's share of `tick`, kept first.
     fn answer(&mut self, tick: u64, at: &mut Place) -> anyhow::Result<()> {
         let b = self.bundle(Kind::Tick(tick), tick)?;
-        let bytes = b.to_bytes();
-        self.keep.keep_answer(tick, &bytes)?;
-        self.answered(&bytes)?;
+        self.keep.keep_answer(tick, &b.to_bytes())?;
         at.ticks = Ticks { done: tick, started: None };
         self.keep.save(at.ticks)?;
         self.put(b.clone())?;
