@@ -86,13 +86,13 @@ fn a_mission_split_over_two_hosts_runs_in_real_time_too() {
 }
 
 /// Waits until `sim/truth` in the bus domain `prefix` passes `at_ns` of the run's time, then
-/// SIGKILLs the domain's Zenoh bridge; returns its pid, or `None` if the launch ended first.
-fn kill_bridge_when(prefix: &str, at_ns: u64, running: impl Fn() -> bool) -> Option<i32> {
+/// SIGKILLs the domain's `service`; returns its pid, or `None` if the launch ended first.
+fn kill_when(prefix: &str, service: &str, at_ns: u64, running: impl Fn() -> bool) -> Option<i32> {
     let bridge = || {
         harvey_bus::live_nodes(prefix)
             .unwrap_or_default()
             .into_iter()
-            .find(|n| n.alive && n.name == "zenoh-bridge")
+            .find(|n| n.alive && n.name == service)
             .map(|n| n.pid)
     };
     while bridge().is_none() {
@@ -118,11 +118,13 @@ fn kill_bridge_when(prefix: &str, at_ns: u64, running: impl Fn() -> bool) -> Opt
     Some(pid)
 }
 
-/// `default-split` over two domains with the bridges SIGKILLed when the run's time passes
-/// `kills` (`(host, ns)`, in time order); checks both shares end well, each killed bridge was
-/// restarted by its host's supervisor, and nothing is left in shared memory. The main host's run
-/// folder.
-fn split_with_kills(tag: &str, kills: &[(&str, u64)]) -> common::Scratch {
+/// A service SIGKILLed on a host when the run's time passes a stamp (ns).
+type Kill<'a> = (&'a str, &'a str, u64);
+
+/// `default-split` over two domains with services SIGKILLed as `kills` say (in time order);
+/// checks both shares end well, each killed service was restarted by its host's supervisor, and
+/// nothing is left in shared memory. The main host's run folder.
+fn split_with_kills(tag: &str, kills: &[Kill]) -> common::Scratch {
     let mission = "missions/default-split.toml";
     let (pa, pb) = (common::unique_prefix(&format!("{tag}a")), common::unique_prefix(&format!("{tag}b")));
     let (main_dir, gpu_dir) =
@@ -149,7 +151,9 @@ fn split_with_kills(tag: &str, kills: &[(&str, u64)]) -> common::Scratch {
         move || std::fs::read_to_string(format!("/proc/{main_pid}/stat")).is_ok_and(|s| !s.contains(") Z "));
     let killed: Vec<Option<i32>> = kills
         .iter()
-        .map(|&(host, at_ns)| kill_bridge_when(if host == "main" { &pa } else { &pb }, at_ns, running))
+        .map(|&(host, service, at_ns)| {
+            kill_when(if host == "main" { &pa } else { &pb }, service, at_ns, running)
+        })
         .collect();
     let status = common::wait_exit(&mut main, Duration::from_secs(300));
     let read = |p: std::path::PathBuf| std::fs::read_to_string(p).expect("log");
@@ -158,15 +162,16 @@ fn split_with_kills(tag: &str, kills: &[(&str, u64)]) -> common::Scratch {
     assert!(status.success() && stdout.contains("goal reached"), "{stdout}\n{stderr}\n--- gpu:\n{gpu_log}");
     assert!(common::wait_exit(&mut gpu, Duration::from_secs(60)).success(), "{gpu_log}");
     assert!(killed.iter().all(Option::is_some), "every kill landed mid-run: {kills:?} {killed:?}");
-    for (host, _) in kills {
+    for (host, service, _) in kills {
         let log = if *host == "main" { &stderr } else { &gpu_log };
-        let said = |what: &str| log.lines().any(|l| l.contains(what) && l.contains("service=zenoh-bridge"));
+        let said =
+            |what: &str| log.lines().any(|l| l.contains(what) && l.contains(&format!("service={service}")));
         assert!(
             said("exited with SIGKILL: restart") && said("restarted"),
-            "the {host} host's supervisor restarted its killed bridge:\n{log}"
+            "the {host} host's supervisor restarted its killed {service}:\n{log}"
         );
     }
-    if kills.iter().any(|(h, _)| *h == "gpu") {
+    if kills.iter().any(|(h, s, _)| (*h, *s) == ("gpu", "zenoh-bridge")) {
         assert!(gpu_log.contains("restarted: asking host main for the tick after"), "{gpu_log}");
     }
     for p in [&pa, &pb] {
@@ -178,16 +183,23 @@ fn split_with_kills(tag: &str, kills: &[(&str, u64)]) -> common::Scratch {
 /// Item 5 of issue 16: each host's bridge SIGKILLed mid-run, in either order and at times that
 /// land in different places of its turn, is restarted by its supervisor and the chain resumes
 /// where it was: the mission reaches its goal and the recording is the one the mission makes on
-/// one host, every time.
+/// one host, every time. So with the gpu host's own parties killed: the bridge there re-offers
+/// what it published to them.
 #[test]
 fn a_bridge_killed_mid_run_on_either_host_comes_back_and_the_recording_is_identical() {
     let s = 1_000_000_000;
     let one = common::run_mission("missions/default-split.toml", "zenoh-kill-one");
     assert!(one.status.success(), "{}", one.stdout);
-    let plans: [&[(&str, u64)]; 3] = [
-        &[("main", 6 * s), ("gpu", 14 * s)],
-        &[("gpu", 5 * s + 230_000_000), ("main", 11 * s + 770_000_000)],
-        &[("main", 9 * s + 310_000_000), ("gpu", 9 * s + 960_000_000), ("main", 20 * s)],
+    let bridge = "zenoh-bridge";
+    let plans: [&[Kill]; 4] = [
+        &[("main", bridge, 6 * s), ("gpu", bridge, 14 * s)],
+        &[("gpu", bridge, 5 * s + 230_000_000), ("main", bridge, 11 * s + 770_000_000)],
+        &[
+            ("main", bridge, 9 * s + 310_000_000),
+            ("gpu", bridge, 9 * s + 960_000_000),
+            ("main", bridge, 20 * s),
+        ],
+        &[("gpu", "vision-workers", 7 * s + 50_000_000), ("gpu", "ums", 15 * s + 420_000_000)],
     ];
     for (i, kills) in plans.iter().enumerate() {
         let main_dir = split_with_kills(&format!("zk{i}"), kills);

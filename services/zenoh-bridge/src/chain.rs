@@ -19,7 +19,6 @@ use std::time::{Duration, Instant};
 use harvey_bus::{Bus, Waiter, Wake};
 use harvey_runtime::taps::Tap;
 use zenoh::Wait;
-use zenoh::liveliness::LivelinessToken;
 use zenoh::pubsub::Publisher;
 use zenoh::qos::CongestionControl;
 
@@ -55,6 +54,9 @@ pub struct Chain<'a> {
     /// The messages of the answer a predecessor kept (the other host), until the next bundle:
     /// never sent again, though the taps may hand them over before the checkpoint knew them taken.
     answered: Vec<(String, u64, u64)>,
+    /// The supervisor's requests to re-offer to a restarted party of this host, served while
+    /// the bridge waits (it publishes what came from the other host, which that party needs).
+    reoffers: std::rc::Rc<harvey_bus::Reoffers>,
 }
 
 impl<'a> Chain<'a> {
@@ -87,7 +89,20 @@ impl<'a> Chain<'a> {
             met: std::cell::Cell::new(false),
             patience,
             answered: Vec::new(),
+            reoffers: bus.reoffers(),
         })
+    }
+
+    /// What rings when the supervisor asks this process to re-offer (attach it to the waiters
+    /// the bridge waits on: [`Chain::receive`] serves it).
+    pub fn reoffer_bell(&self) -> std::rc::Rc<harvey_bus::Reoffers> {
+        self.reoffers.clone()
+    }
+
+    /// Answers the supervisor's pending re-offer requests.
+    pub(crate) fn serve_reoffers(&self) -> anyhow::Result<()> {
+        self.reoffers.serve()?;
+        Ok(())
     }
 
     /// What rings when the other host's bundle arrives.
@@ -163,20 +178,6 @@ impl<'a> Chain<'a> {
         failed.map_or(Ok(()), Err)
     }
 
-    /// Says this host's bridge is up (a liveliness token the other host's bridge waits for).
-    pub fn declare_ready(
-        &self,
-        session: &zenoh::Session,
-        namespace: &str,
-        host: &str,
-    ) -> anyhow::Result<LivelinessToken> {
-        session
-            .liveliness()
-            .declare_token(crate::peers::ready_key(namespace, host))
-            .wait()
-            .map_err(|e| anyhow::anyhow!("declaring this host ready on Zenoh: {e}"))
-    }
-
     /// Waits for the other host's next bundle, sending `again` every few seconds meanwhile;
     /// `None` if this process is asked to stop first.
     pub(crate) fn receive(
@@ -190,7 +191,9 @@ impl<'a> Chain<'a> {
             if let Some(a) = self.inbox.next() {
                 return Ok(Some(a.payload));
             }
-            match waiter.wait(Some(STALL_REPORT))? {
+            let wake = waiter.wait(Some(STALL_REPORT))?;
+            self.serve_reoffers()?;
+            match wake {
                 Wake::Shutdown => return Ok(None),
                 Wake::Timeout => {
                     tracing::warn!(

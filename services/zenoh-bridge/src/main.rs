@@ -160,7 +160,7 @@ fn run_chain(
     let lockstep = pace.lockstep();
     tracing::info!(host = args.host, peer, ?role, lockstep = lockstep.is_some(), listen = ?args.listen, connect = ?args.connect, "carrying every topic to the other host over Zenoh");
     let Some(lockstep) = lockstep else {
-        let _ready = chain.declare_ready(session, &args.namespace, &args.host)?;
+        let _ready = peers::declare_ready(session, &args.namespace, &args.host)?;
         if role == Role::StandIn {
             peers::await_peer(session, &args.namespace, peer, wait)?;
         }
@@ -176,7 +176,8 @@ fn run_chain(
     let _attached = pace.attach(&waiter, &[])?;
     let turn_waiter = Waiter::new()?;
     let bell = FdSource::new(chain.bell())?;
-    let _bell = turn_waiter.attach(&bell)?;
+    let reoffers = chain.reoffer_bell();
+    let _bell = (turn_waiter.attach(&bell)?, turn_waiter.attach(&*reoffers)?);
     harvey_runtime::notify_ready()?;
     // A restarted bridge may be granted a tick twice (the supervisor's grant and its
     // predecessor's progress, if that came after this process subscribed): the turn is taken once.

@@ -99,3 +99,16 @@ pub fn await_peer(
         std::thread::sleep(Duration::from_millis(100));
     }
 }
+
+/// Says this host's bridge is up (a liveliness token the other host's bridge waits for).
+pub fn declare_ready(
+    session: &zenoh::Session,
+    namespace: &str,
+    host: &str,
+) -> anyhow::Result<zenoh::liveliness::LivelinessToken> {
+    session
+        .liveliness()
+        .declare_token(ready_key(namespace, host))
+        .wait()
+        .map_err(|e| anyhow::anyhow!("declaring this host ready on Zenoh: {e}"))
+}

@@ -32,7 +32,8 @@ impl Chain<'_> {
     ) -> anyhow::Result<()> {
         let waiter = Waiter::new()?;
         let bell = FdSource::new(self.inbox.bell())?;
-        let _a = (waiter.attach(lockstep.predecessor())?, waiter.attach(&bell)?);
+        let reoffers = self.reoffer_bell();
+        let _a = (waiter.attach(lockstep.predecessor())?, waiter.attach(&bell)?, waiter.attach(&*reoffers)?);
         let kept = self.keep.last_answer()?;
         if let Some((_, b)) = &kept {
             self.answered(b)?;
@@ -48,7 +49,7 @@ impl Chain<'_> {
             // From here on a successor is a restart: it asks for the tick under way.
             self.keep.save(at.ticks)?;
         }
-        let _ready = self.declare_ready(session, namespace, host)?;
+        let _ready = crate::peers::declare_ready(session, namespace, host)?;
         if resumed && !self.rejoin(&waiter, lockstep, &mut at)? {
             return Ok(());
         }
@@ -157,7 +158,9 @@ impl Chain<'_> {
             if at.tail.is_some_and(|d| d >= tick) {
                 return Ok(true);
             }
-            match waiter.wait(Some(STALL_REPORT))? {
+            let wake = waiter.wait(Some(STALL_REPORT))?;
+            self.serve_reoffers()?;
+            match wake {
                 Wake::Shutdown => return Ok(false),
                 Wake::Timeout => tracing::warn!(
                     waited_s = since.elapsed().as_secs(),
