@@ -119,12 +119,16 @@ impl Keep {
     /// Keeps the answer for `tick` (the other host), before it is sent.
     pub fn keep_answer(&self, tick: u64, bundle: &[u8]) -> anyhow::Result<()> {
         let Some(path) = &self.answer else { return Ok(()) };
-        let mut bytes = Vec::with_capacity(12 + bundle.len());
-        bytes.extend_from_slice(&tick.to_le_bytes());
-        bytes.extend_from_slice(&crc32fast::hash(bundle).to_le_bytes());
-        bytes.extend_from_slice(bundle);
+        let mut head = [0u8; 12];
+        head[..8].copy_from_slice(&tick.to_le_bytes());
+        head[8..].copy_from_slice(&crc32fast::hash(bundle).to_le_bytes());
         let aside = path.with_extension("new");
-        std::fs::write(&aside, &bytes)
+        // The header and the bundle as they are: no copy of the bundle per tick.
+        std::fs::File::create(&aside)
+            .and_then(|mut f| {
+                std::io::Write::write_all(&mut f, &head)
+                    .and_then(|()| std::io::Write::write_all(&mut f, bundle))
+            })
             .map_err(|e| anyhow::anyhow!("keeping the answer in {}: {e}", aside.display()))?;
         std::fs::rename(&aside, path)
             .map_err(|e| anyhow::anyhow!("keeping the answer in {}: {e}", path.display()))
