@@ -258,7 +258,12 @@ fn main() -> anyhow::Result<()> {
             || last_send.elapsed() >= flush_every / 2
             || intake.until_ns != u64::MAX && intake.until_ns >= sent_ns.saturating_add(quarter_flush_ns);
         if due && (!intake.batch.items.is_empty() || !intake.batch.loop_latency.is_empty()) {
-            writer.send(std::mem::take(&mut intake.batch))?;
+            // What a SIGKILL would lose: this batch, what is held until the next (a quarter
+            // interval), and what the writer has not flushed, kept within half an interval.
+            if intake.until_ns != u64::MAX {
+                writer.bound_lag(intake.until_ns, 2 * quarter_flush_ns)?;
+            }
+            writer.send(std::mem::take(&mut intake.batch), intake.until_ns)?;
             (turns_held, last_send) = (0, Instant::now());
             if intake.until_ns != u64::MAX {
                 sent_ns = intake.until_ns;
