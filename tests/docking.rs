@@ -78,7 +78,7 @@ fn docking_recovers_from_the_occluding_cart_and_ends_within_several_inches() {
 
 #[test]
 fn over_seeds_it_docks_within_several_inches() {
-    for condition in ["ideal", "nominal"] {
+    for condition in ["ideal", "nominal", "harsh"] {
         for seed in 1..=3 {
             let out = common::run_mission_under("missions/docking.toml", condition, seed, "docks");
             let (_, trace, truth) = decode(&out);
@@ -93,8 +93,8 @@ fn over_seeds_it_docks_within_several_inches() {
             // 004 §1's several inches; an inch where the map is the world.
             let bound = if condition == "ideal" { 1.0 } else { 6.0 };
             assert!(off_in < bound, "{condition} s{seed}: {off_in:.2} in from the mark");
-            // No heading bound here: 004 gives none, and nominal seed 2 ends 19 degrees off
-            // square (docs/evaluation.md).
+            // No heading bound here: 004 gives none, and 3 of 60 sweep runs end 10-14 degrees
+            // off square (docs/evaluation.md).
         }
     }
 }

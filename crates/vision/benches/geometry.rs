@@ -6,7 +6,7 @@ use std::hint::black_box;
 
 use harvey_vision::depth::{DepthFromMotion, DepthParams};
 use harvey_vision::flf::{Flf, FlfParams, Line};
-use harvey_vision::hough::{DockModel, Hypothesis, find_dock};
+use harvey_vision::hough::{DockModel, HoughScratch, Hypothesis, find_dock};
 use harvey_vision::moravec::MoravecParams;
 use harvey_vision::path::{ImageLine, PathParams, PathTracker};
 use harvey_vision::stereo::{Stereo, StereoParams};
@@ -142,7 +142,7 @@ pub fn bench_hough(img: &GrayBuf, size: &str, rows: &mut Vec<Row>) {
         [30.0, 35.0, 40.0, 45.0, 50.0].iter().map(|&scale| Hypothesis { scale, rotation: 0.0 }).collect();
     let model = DockModel::frame_with_post();
     let dims = [img.width, img.height];
-    let mut votes = Vec::new();
+    let mut votes = HoughScratch::default();
     for (scope, win, lines) in lines(img, 192) {
         rows.push(measure(
             Row::new(

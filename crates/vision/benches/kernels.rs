@@ -348,10 +348,16 @@ fn main() {
         return;
     }
     let mut rows = Vec::new();
+    // `hough`: the constrained Hough's rows alone.
+    let hough_only = std::env::args().any(|a| a == "hough");
     for (w, h) in [(640u32, 480u32), (256, 256)] {
         let img = frame(&world, w, h);
         write_pgm(&out.join(format!("frame_{w}x{h}.pgm")), &img);
         let size = format!("{w}x{h}");
+        if hough_only {
+            geometry::bench_hough(&img, &size, &mut rows);
+            continue;
+        }
         bench_nc(&img.view(), &size, &mut rows);
         bench_moravec(&img.view(), &size, &mut rows);
         bench_flf(&img.view(), &size, &mut rows);

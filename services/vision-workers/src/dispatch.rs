@@ -10,7 +10,7 @@ use harvey_msgs::{
 use harvey_vision::cues::{ActivityDetector, ActivityVote, brightest};
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::frs::{ClassRange, Frs};
-use harvey_vision::hough::{DockModel, Hypothesis, find_dock, post_heights};
+use harvey_vision::hough::{DockModel, HoughScratch, Hypothesis, find_dock, post_heights};
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect, VisionError};
@@ -32,7 +32,7 @@ pub struct Dispatcher {
     activity: std::collections::BTreeMap<u32, ActivityDetector>,
     dock_model: DockModel,
     hypotheses: Vec<Hypothesis>,
-    dock_votes: Vec<f32>,
+    dock_scratch: HoughScratch,
     poles: Vec<[f32; 6]>,
     seq: u64,
 }
@@ -79,7 +79,7 @@ impl Dispatcher {
             activity: std::collections::BTreeMap::new(),
             dock_model: DockModel::frame_with_post(),
             hypotheses: Vec::new(),
-            dock_votes: Vec::new(),
+            dock_scratch: HoughScratch::default(),
             poles: Vec::new(),
             seq: 0,
         }
@@ -205,12 +205,17 @@ impl Dispatcher {
                 }));
                 let p = FlfParams { min_length: 6.0, ..FlfParams::default() };
                 let lines = self.flf.lines(&img, window, &p).map_err(|e| status_of(&e))?;
-                let found =
-                    find_dock(lines, &self.dock_model, &self.hypotheses, [w, ht], 4.0, &mut self.dock_votes);
+                let found = find_dock(
+                    lines,
+                    &self.dock_model,
+                    &self.hypotheses,
+                    [w, ht],
+                    4.0,
+                    &mut self.dock_scratch,
+                );
                 if let Some(m) = found.filter(|m| m.certainty >= min_certainty) {
-                    let scale = self.hypotheses[m.hypothesis].scale;
-                    let [left, right] = post_heights(lines, m.at, scale);
-                    push([m.at[0], m.at[1], m.certainty, scale, left, right]);
+                    let [left, right] = post_heights(lines, m.at, m.scale);
+                    push([m.at[0], m.at[1], m.certainty, m.scale, left, right]);
                 }
             }
             VisionAlgorithm::Poles => {
