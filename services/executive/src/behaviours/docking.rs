@@ -13,7 +13,7 @@ use harvey_msgs::{
     VisionResult, VisionStatus,
 };
 
-use super::dock_pose::{face_distance, pose_from_dock};
+use super::dock_pose::{dock_sight, face_distance, weighed_fix};
 use super::drive::{self, DriveParams, Vectors};
 use super::fsa::{Fsa, Trigger};
 use super::region::Region;
@@ -50,6 +50,8 @@ pub struct Docking {
     /// The believed heading when the target was last seen, and ticks since the last fix asked.
     target_heading: f64,
     since_fix: u32,
+    /// The believed heading's variance as of the last fix (rad²).
+    heading_var: Option<f64>,
 }
 
 impl Docking {
@@ -82,6 +84,7 @@ impl Docking {
             region: None,
             target_heading: 0.0,
             since_fix: 0,
+            heading_var: None,
         }
     }
 
@@ -139,9 +142,14 @@ impl Docking {
             Some(region) => region.admits(p, gate_m, gate_rad),
             None => true,
         };
-        if let (true, Some(v)) = (dock, &item)
-            && let Some(p) = pose_from_dock(&self.g, self.focal_px, self.centre_px[0], v).filter(near)
-        {
+        let prior = self.heading_var.filter(|_| self.belief.has_fix());
+        let weighed = item
+            .as_ref()
+            .filter(|_| dock)
+            .and_then(|v| dock_sight(&self.g, self.focal_px, self.centre_px[0], v))
+            .map(|s| weighed_fix(&self.g, &s, at, prior, self.belief.travelled_m()));
+        if let Some((p, var)) = weighed.filter(|(p, _)| near(p)) {
+            self.heading_var = Some(var);
             tracing::info!(
                 x = p.x_m,
                 y = p.y_m,

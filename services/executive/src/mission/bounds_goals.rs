@@ -75,6 +75,8 @@ pub(crate) fn check_docking(k: &KeyPath, d: &DockingGoal) -> Result<(), OutOfRan
     check(&k.key("fix_beyond_m"), d.fix_beyond_m, &LENGTH_OR_ZERO)?;
     check(&k.key("fix_gate_m"), d.fix_gate_m, &LENGTH)?;
     check(&k.key("fix_gate_deg"), d.fix_gate_deg, &HALF_TURN)?;
+    check(&k.key("post_height_sd_px"), d.post_height_sd_px, &Range::above(0.0, 100.0, "px"))?;
+    check(&k.key("heading_drift_deg_per_m"), d.heading_drift_deg_per_m, &Range::above(0.0, 90.0, "deg/m"))?;
     check(&k.key("final_m"), d.final_m, &LENGTH)?;
     check(&k.key("too_close_m"), d.too_close_m, &LENGTH_OR_ZERO)?;
     check(&k.key("ballistic_mps"), d.ballistic_mps, &SPEED)?;

@@ -80,6 +80,10 @@ pub struct DockingGoal {
     /// After the first, a fix further than these from the belief is taken as a misreading.
     pub fix_gate_m: f64,
     pub fix_gate_deg: f64,
+    /// A fix's heading from the posts is weighed against the belief's: each post's height is
+    /// read to this (pixels), and odometry's heading drifts this much a metre (degrees).
+    pub post_height_sd_px: f64,
+    pub heading_drift_deg_per_m: f64,
     /// Docked when the robot's centre is this far from the face; closer than `too_close_m` is
     /// a fatal error.
     pub final_m: f64,
