@@ -30,7 +30,8 @@ pub enum VisionAlgorithm {
     RegionSegmenter = 4,
     /// Phototropic perception (004 §4.1): the largest region within `params[0]` grey levels
     /// (default 20) of the brightest pixel, of at least `params[1]` pixels (default 20).
-    /// Item: `[cx, cy, area, mean, 0, 0]`.
+    /// Item: `[cx, cy, area, mean, median, 0]`, `median` the window's median grey level (what
+    /// the region's brightness is judged against).
     Phototropic = 5,
     /// Activity detection (004 §4.1), best as a standing request: the motion over the last
     /// `params[2]` frames (default 4) of the window (which must keep its size), each frame

@@ -70,7 +70,6 @@ const NON_NEGATIVE: &[&str] = &[
     "frame_height_m",
     "target_height_m",
     "target_grey",
-    "light_min_grey",
     "hough_min_certainty",
     "fix_every_ticks",
     "noise_ticks",

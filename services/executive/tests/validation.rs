@@ -94,8 +94,8 @@ fn goal_tables_refuse_numbers_their_checks_let_through() {
         e,
         format!("m.toml:{line}: key `mission.docking.keep_in_view_deg`: -1 is outside (0, 180] deg")
     );
-    let e = refusal(&with(DOCKING, "light_min_grey = 200.0", "light_min_grey = nan"));
-    assert!(e.contains("key `mission.docking.light_min_grey`"), "{e}");
+    let e = refusal(&with(DOCKING, "light_contrast = 1.3", "light_contrast = nan"));
+    assert!(e.contains("key `mission.docking.light_contrast`"), "{e}");
     let e = refusal(&with(DOCKING, "hough_range_sd_m = 1.22", "hough_range_sd_m = inf"));
     assert!(e.contains("key `mission.docking.hough_range_sd_m`"), "{e}");
     let e = refusal(&with(POLES, "avoid_gain = 0.4", "avoid_gain = nan"));

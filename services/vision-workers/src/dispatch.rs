@@ -11,6 +11,7 @@ use harvey_vision::cues::{ActivityDetector, ActivityVote, brightest};
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::frs::{ClassRange, Frs};
 use harvey_vision::hough::{DockModel, HoughScratch, Hypothesis, find_dock, post_heights};
+use harvey_vision::levels;
 use harvey_vision::moravec::{Moravec, MoravecParams};
 use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect, VisionError};
@@ -187,7 +188,8 @@ impl Dispatcher {
                 let found = brightest(&mut self.frs, &img, window, margin as u8, area as u32)
                     .map_err(|e| status_of(&e))?;
                 if let Some(r) = found {
-                    push([r.centroid[0], r.centroid[1], r.area as f32, r.mean, 0.0, 0.0]);
+                    let median = levels::percentile(&levels::histogram(&img, window), 0.5);
+                    push([r.centroid[0], r.centroid[1], r.area as f32, r.mean, f32::from(median), 0.0]);
                 }
             }
             VisionAlgorithm::Dock => {

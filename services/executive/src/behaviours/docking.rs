@@ -165,7 +165,7 @@ impl Docking {
         match (self.perception(), item) {
             // A fix asked for while tracking: nothing more to it.
             ("region-tracking", _) if dock => {}
-            ("phototropic", Some(v)) if v[3] >= self.g.light_min_grey => {
+            ("phototropic", Some(v)) if self.is_lamp(&v) => {
                 self.light_rad = Some(at.heading_rad + ((self.centre_px[0] - v[0]) / self.focal_px).atan());
             }
             // A lamp not seen now is no direction to go in: a bearing from elsewhere leads past the
@@ -184,6 +184,13 @@ impl Docking {
             ("region-tracking", _) => self.track(r),
             _ => {}
         }
+    }
+
+    /// Whether a phototropic item `[cx, cy, area, mean, median, _]` can be the lamp: bright
+    /// against the window's median, above the optical centre, no bigger than the lamp near.
+    fn is_lamp(&self, v: &[f64; 6]) -> bool {
+        let biggest = self.g.lamp_area_m2 * (self.focal_px / self.g.light_near_m).powi(2);
+        v[3] >= self.g.light_contrast * v[4] && v[1] < self.centre_px[1] && v[2] <= biggest
     }
 
     /// A region-segmenter answer in tracking: the region nearest the prediction, if it is about

@@ -62,7 +62,9 @@ pub(crate) fn check_docking(k: &KeyPath, d: &DockingGoal) -> Result<(), OutOfRan
     check(&k.key("target_side_m"), d.target_side_m, &SIZE)?;
     check(&k.key("target_height_m"), d.target_height_m, &HEIGHT)?;
     check_all(&k.key("target_grey"), &d.target_grey, &GREY)?;
-    check(&k.key("light_min_grey"), d.light_min_grey, &GREY)?;
+    check(&k.key("light_contrast"), d.light_contrast, &Range::closed(1.0, 255.0, "x"))?;
+    check(&k.key("lamp_area_m2"), d.lamp_area_m2, &Range::above(0.0, 100.0, "m2"))?;
+    check(&k.key("light_near_m"), d.light_near_m, &LENGTH)?;
     check(&k.key("hough_range_m"), d.hough_range_m, &LENGTH)?;
     check(&k.key("hough_range_sd_m"), d.hough_range_sd_m, &LENGTH_OR_ZERO)?;
     check(&k.key("hough_min_certainty"), d.hough_min_certainty, &FRACTION)?;

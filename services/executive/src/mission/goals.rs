@@ -50,9 +50,14 @@ pub struct DockingGoal {
     pub target_side_m: f64,
     pub target_height_m: f64,
     pub target_grey: [f64; 2],
-    /// The phototropic cue counts only a region this bright (grey level): with the lamp hidden,
-    /// the brightest thing in view is something else.
-    pub light_min_grey: f64,
+    /// The phototropic cue counts only a region this many times brighter than the window's
+    /// median grey level (with the lamp hidden, the brightest thing in view is something
+    /// else)...
+    pub light_contrast: f64,
+    /// ...and only a region the lamp's size could make: above the optical centre (the lamp is
+    /// above the camera), no bigger than a lamp of `lamp_area_m2` seen from `light_near_m`.
+    pub lamp_area_m2: f64,
+    pub light_near_m: f64,
     /// The Hough is tried once the dock is believed this near, give or take (scale hypotheses),
     /// with matches covering at least this share of the model; after a failure, once the robot
     /// has moved this far for a new view.
