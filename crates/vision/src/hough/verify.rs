@@ -1,9 +1,10 @@
 //! The Hough peaks verified (004 §4.1.2's coverage check): round each peak the reference point
 //! is tried over the scales between the hypotheses' (widened a tenth either way), coarsely
-//! (placements a cell apart, every other pixel a model unit), then fitted to the lines that
-//! cover it by least squares, and scored by how much of the model the image lines cover. The hypotheses alone are too coarse: five of them spread over the
-//! believed distance +-1.22 m lie 16-34 px a model unit apart at 2.5-3.5 m, while a line must
-//! lie within 3 px of the model to cover it.
+//! (placements a cell apart, every other pixel a model unit), then fitted by least squares to
+//! the lines that cover it, and scored by how much of the model the image lines cover. The
+//! hypotheses alone are too coarse: five of them spread over the believed distance +-1.22 m lie
+//! 16-34 px a model unit apart at 2.5-3.5 m, while a line must lie within 3 px of the model to
+//! cover it.
 
 use super::{DockMatch, DockModel, Hypothesis};
 use crate::flf::Line;
