@@ -3,6 +3,7 @@
 //! bar, and writes `DIR/sweep.csv`, `DIR/sweep.md` and `DIR/sweep.png`.
 
 mod conditions;
+mod disk;
 mod figures;
 mod font;
 mod plan;
@@ -147,7 +148,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<i32> {
     let exe = std::env::current_exe()?;
     let mut rows: Vec<Row> = Vec::new();
     let mut order = Vec::new();
-    let ending = runner::run_all(&exe, jobs, max, &interrupt, |d| {
+    let ending = runner::run_all(&exe, jobs, max, &out, &interrupt, |d| {
         let row = finish(d, &cond_names, figure, args.keep);
         say(format!(
             "  {} s{}: {}, {}: {}",
@@ -190,6 +191,15 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<i32> {
         );
     }
     let files = ["sweep.csv", "sweep.md", "sweep.png"].map(|f| out.join(f).display().to_string()).join(", ");
+    if let Some(why) = &ending.short_of_disk {
+        println!(
+            "stopped short of disk: {why}; {} runs not started; the {} finished rows of {} are in {files}",
+            ending.not_started,
+            rows.len(),
+            header.planned
+        );
+        return Ok(1);
+    }
     if ending.interrupted {
         println!(
             "interrupted: stopped {} runs; the {} finished rows of {} are in {files}",

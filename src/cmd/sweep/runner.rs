@@ -48,6 +48,9 @@ pub struct Done {
 pub struct Ending {
     pub interrupted: bool,
     pub stopped: Vec<Job>,
+    /// Why no more runs were started for lack of disk (`disk.rs`), and how many were not.
+    pub short_of_disk: Option<String>,
+    pub not_started: usize,
 }
 
 /// SIGINT and SIGTERM, noticed: set once either arrives.
@@ -92,21 +95,28 @@ fn start(exe: &Path, job: Job) -> anyhow::Result<Running> {
     Ok(Running { job, child, started: Instant::now(), log })
 }
 
-/// Runs `jobs`, at most `max` at once, calling `done` as each ends; stops on `interrupt`.
+/// Runs `jobs`, at most `max` at once, calling `done` as each ends; stops on `interrupt`, and
+/// starts no more once `out`'s disk lacks room for another run (those running finish).
 pub fn run_all(
     exe: &Path,
     jobs: Vec<Job>,
     max: usize,
+    out: &Path,
     interrupt: &AtomicBool,
     mut done: impl FnMut(Done) -> anyhow::Result<()>,
 ) -> anyhow::Result<Ending> {
     let mut queue = jobs.into_iter();
     let mut running: Vec<Running> = Vec::new();
+    let (mut reserve, mut short_of_disk) = (super::disk::Reserve::default(), None);
     loop {
         if interrupt.load(Ordering::Relaxed) {
-            return Ok(Ending { interrupted: true, stopped: stop_all(running) });
+            return Ok(Ending { interrupted: true, stopped: stop_all(running), ..Ending::default() });
         }
-        while running.len() < max.max(1) {
+        while running.len() < max.max(1) && short_of_disk.is_none() {
+            short_of_disk = reserve.short(out, super::disk::free_bytes(out)?);
+            if short_of_disk.is_some() {
+                break;
+            }
             let Some(job) = queue.next() else { break };
             match start(exe, job) {
                 Ok(r) => running.push(r),
@@ -117,7 +127,12 @@ pub fn run_all(
             }
         }
         if running.is_empty() {
-            return Ok(Ending::default());
+            let not_started = queue.count();
+            return Ok(Ending {
+                short_of_disk: short_of_disk.filter(|_| not_started > 0),
+                not_started,
+                ..Ending::default()
+            });
         }
         let mut i = 0;
         while i < running.len() {
@@ -131,10 +146,13 @@ pub fn run_all(
                     let r = running.swap_remove(i);
                     let _ = std::fs::remove_file(&r.job.launch);
                     let wall_s = r.started.elapsed().as_secs_f64();
+                    let run_dir = r.job.run_dir.clone();
                     if let Err(e) = done(Done { job: r.job, exit_code: status.code(), wall_s, log: r.log }) {
                         stop_all(running);
                         return Err(e);
                     }
+                    // What `done` left of the run (a failed run's recording).
+                    reserve.kept(&run_dir);
                 }
             }
         }
