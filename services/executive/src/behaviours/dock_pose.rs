@@ -57,12 +57,6 @@ pub fn dock_sight(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64; 6]
     Some(DockSight { heading_rad, heading_sd_rad: sd_sin / turned.cos(), ray_m, bearing_rad })
 }
 
-/// The robot's pose from the dock recognised in the image alone ([`dock_sight`] at its own
-/// heading).
-pub fn pose_from_dock(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64; 6]) -> Option<Pose2> {
-    dock_sight(g, focal_px, centre_u, item).map(|s| s.pose(g, s.heading_rad))
-}
-
 /// A fix from `s`: its heading weighed against the belief's (`believed`, of variance `prior` as
 /// of the last fix, `None` before the first, grown by odometry's drift over `travelled_m`), and
 /// the pose the frame's range and bearing give at the weighed heading; with the heading's new
@@ -110,6 +104,11 @@ mod tests {
         let centre = [13.6, 0.0];
         let u = 320.0 - f * left_of(centre) / depth(centre);
         [u, 200.0, 0.9, f * 0.5 / depth(centre), f * 0.5 / depth([13.6, 0.5]), f * 0.5 / depth([13.6, -0.5])]
+    }
+
+    /// The robot's pose from the dock in the image alone (at the posts' own heading).
+    fn pose_from_dock(g: &DockingGoal, focal_px: f64, centre_u: f64, item: &[f64; 6]) -> Option<Pose2> {
+        dock_sight(g, focal_px, centre_u, item).map(|s| s.pose(g, s.heading_rad))
     }
 
     #[test]
