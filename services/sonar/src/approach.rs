@@ -60,8 +60,6 @@ struct Window {
     last_stamp: u64,
     /// Consecutive readings that showed an approach within the time to contact.
     streak: u32,
-    /// The latest reading showed something coming, however far.
-    closing: bool,
 }
 
 impl Window {
@@ -149,11 +147,10 @@ impl Approach {
         [(b.x_m - a.x_m) / dt, (b.y_m - a.y_m) / dt]
     }
 
-    /// Folds in a ring's new readings; returns the mask of sensors whose latest reading showed
-    /// something coming at the robot at least the least approach speed, whatever its time to
-    /// contact (the streaks count readings within it).
-    pub fn on_ring(&mut self, ring: &SonarRing) -> u32 {
-        let mut mask = 0;
+    /// Folds in a ring's new readings: each sensor's streak counts its consecutive readings
+    /// that showed something coming at the robot at least the least approach speed, within the
+    /// time to contact.
+    pub fn on_ring(&mut self, ring: &SonarRing) {
         let v = self.velocity();
         for i in 0..SONAR_SENSORS {
             let (r, stamp) = (ring.range_m[i], ring.reading_stamp_ns[i]);
@@ -165,7 +162,6 @@ impl Approach {
                 continue;
             }
             if stamp <= w.last_stamp {
-                mask |= u32::from(w.closing) << i;
                 continue; // no new reading of this sensor
             }
             w.last_stamp = stamp;
@@ -186,12 +182,11 @@ impl Approach {
             w.push(reading);
             let approach = w.slope().map_or(0.0, |s| -s);
             let closing = approach + v[0] * u[0] + v[1] * u[1];
-            w.closing = approach >= self.p.min_approach_mps && closing > 0.0;
-            let coming = w.closing && f64::from(r) / closing <= self.p.ttc_s;
+            let coming = approach >= self.p.min_approach_mps
+                && closing > 0.0
+                && f64::from(r) / closing <= self.p.ttc_s;
             w.streak = if coming { w.streak + 1 } else { 0 };
-            mask |= u32::from(w.closing) << i;
         }
-        mask
     }
 
     /// Consecutive readings of sensor `i` that showed an approach.

@@ -37,19 +37,38 @@ enum Phase {
     Watching,
     /// Stop sent; waiting for the vehicle to be still.
     Stopping,
-    Turning {
-        id: u32,
-        sent_ns: u64,
-    },
-    Dashing {
-        id: u32,
-        sent_ns: u64,
-    },
+    Turning(Step),
+    Dashing(Step),
     /// No room for another dash: the robot keeps still (an urgent stop every `HOLD_NS`) until
     /// the object stops approaching.
     Holding {
         sent_ns: u64,
     },
+}
+
+/// A turn or dash sent to the vehicle.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+struct Step {
+    id: u32,
+    sent_ns: u64,
+    /// The vehicle has moved since it was sent.
+    moved: bool,
+}
+
+impl Step {
+    /// Done: the vehicle, having moved on it, is still. Odometry names the newest command
+    /// published, which during an evasion is often the executive's that the bridge refused, so
+    /// the vehicle's motion, not the name, tells when the step is over.
+    fn finished(&self, o: &Odometry) -> bool {
+        let named = o.command.command_id == self.id && o.command_accepted == 1;
+        o.moving == 0 && (self.moved || named)
+    }
+
+    /// Never run: the vehicle has not moved on it for this long (it refused the step).
+    fn lost(&self, o: &Odometry) -> bool {
+        let named = o.command.command_id == self.id;
+        !self.moved && !named && o.moving == 0 && o.header.stamp_ns > self.sent_ns + RESEND_NS
+    }
 }
 
 /// While holding, the stop is repeated this often (ns), so that the executive sees the reflex
@@ -73,7 +92,7 @@ const MAX_TURN_RAD: f64 = 0.052;
 pub struct PanicAvoid {
     p: AvoidParams,
     approach: Approach,
-    /// Set by the latest ring: some sensor (any bearing) saw an approach.
+    /// Set by the latest ring: some sensor (any bearing) confirmed an approach.
     approaching: bool,
     /// Clearance at the left, right and straight ahead (m) from the latest ring.
     clearance: [f64; 2],
@@ -139,18 +158,17 @@ impl PanicAvoid {
         let t = o.header.stamp_ns;
         self.approach.on_odometry(o);
         self.moving = o.moving != 0;
-        let finished = |id: u32| o.command.command_id == id && o.command_accepted == 1 && o.moving == 0;
-        let lost = |id: u32, sent: u64| o.command.command_id != id && o.moving == 0 && t > sent + RESEND_NS;
+        if let Phase::Turning(step) | Phase::Dashing(step) = &mut self.phase {
+            step.moved |= self.moving;
+        }
         let turn = self.away * self.p.turn_rad;
         match self.phase {
             // Away from the object (left is a positive turn).
             Phase::Stopping if !self.moving => Some(self.turn(t, turn)),
-            Phase::Turning { id, sent_ns } if lost(id, sent_ns) => Some(self.turn(t, turn)),
-            Phase::Dashing { id, sent_ns } if lost(id, sent_ns) => {
-                Some(self.dash(t, self.dash_room().max(0.0)))
-            }
-            Phase::Turning { id, .. } | Phase::Dashing { id, .. } if finished(id) => {
-                let first = matches!(self.phase, Phase::Turning { .. });
+            Phase::Turning(step) if step.lost(o) => Some(self.turn(t, turn)),
+            Phase::Dashing(step) if step.lost(o) => Some(self.dash(t, self.dash_room().max(0.0))),
+            Phase::Turning(step) | Phase::Dashing(step) if step.finished(o) => {
+                let first = matches!(self.phase, Phase::Turning(_));
                 // A dash, and more while the object still approaches, cut short of anything
                 // ahead (the panic-stop would freeze the robot there anyway).
                 let room = self.dash_room();
@@ -174,7 +192,7 @@ impl PanicAvoid {
 
     fn turn(&mut self, t: u64, angle_rad: f64) -> MotionCommand {
         let c = self.command(CommandKind::Turn, t, 0.0, angle_rad);
-        self.phase = Phase::Turning { id: c.command_id, sent_ns: t };
+        self.phase = Phase::Turning(Step { id: c.command_id, sent_ns: t, moved: false });
         c
     }
 
@@ -190,16 +208,22 @@ impl PanicAvoid {
 
     fn dash(&mut self, t: u64, length_m: f64) -> MotionCommand {
         let c = self.command(CommandKind::Move, t, length_m, 0.0);
-        self.phase = Phase::Dashing { id: c.command_id, sent_ns: t };
+        self.phase = Phase::Dashing(Step { id: c.command_id, sent_ns: t, moved: false });
         c
     }
 
     /// Folds in a ring; returns the urgent stop that starts an evasion.
     pub fn on_ring(&mut self, ring: &SonarRing) -> Option<MotionCommand> {
-        self.approaching = self.approach.on_ring(ring) != 0;
+        self.approach.on_ring(ring);
+        let confirmed = |i: usize| self.approach.streak(i) >= self.p.confirm;
+        // "Until no sensor senses the object approaching" (001 §6.2), on the evidence that
+        // starts an evasion: several confirming readings of one sensor. A single reading closing
+        // somewhere on the ring is not that: with 3 cm of range noise one of 24 sensors nearly
+        // always shows one, and the robot held still for the rest of its run.
+        self.approaching = (0..SONAR_SENSORS).any(confirmed);
         let trigger = (0..SONAR_SENSORS).any(|i| {
             let b = bearing_rad(i);
-            b.min(std::f64::consts::TAU - b) <= self.p.arc_rad && self.approach.streak(i) >= self.p.confirm
+            b.min(std::f64::consts::TAU - b) <= self.p.arc_rad && confirmed(i)
         });
         let side = |i: usize| {
             if ring.valid_mask & (1 << i) != 0 { f64::from(ring.range_m[i]) } else { f64::INFINITY }

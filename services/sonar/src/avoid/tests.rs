@@ -172,3 +172,89 @@ fn a_refused_turn_is_sent_again() {
     assert_eq!(again.kind(), Some(CommandKind::Turn));
     assert_ne!(again.command_id, turn.command_id);
 }
+
+#[test]
+fn one_dash_once_the_object_has_gone_whatever_the_ring_s_noise() {
+    // Twenty draws of the noise: a rule that ends the evasion on a ring that happens to show
+    // nothing closing passes some of them.
+    for draw in 1..=20_u64 {
+        let (steps, held_s) = evade_then_noise(draw);
+        assert_eq!(steps, [Some(CommandKind::Move)], "draw {draw}: the dash, and nothing more");
+        // The turn and the dash take a second each.
+        assert!(held_s < 2.5, "draw {draw}: the reflex held the robot {held_s} s after its turn");
+    }
+}
+
+/// Every sensor reads a still scene 1.5-2.7 m away with uniform noise of +-5 cm (sd 2.9 cm,
+/// harsh's range noise): some sensor of the 24 shows a reading closing on most rings, but none
+/// several in a row. An object comes at the robot head-on and has gone once it has turned.
+/// The steps the reflex sends after its turn, and how long after the turn it was evading.
+fn evade_then_noise(draw: u64) -> (Vec<Option<CommandKind>>, f64) {
+    let mut seed = 0x9e37_79b9_7f4a_7c15_u64.wrapping_mul(draw);
+    let mut noise = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 0.1 - 0.05
+    };
+    let mut noisy = |t: f64, ahead: Option<f64>| {
+        let mut r = ring(t, 2.0, 1.0, 1.5);
+        for (i, range) in r.range_m.iter_mut().enumerate() {
+            *range = (1.5 + 0.05 * i as f64 + noise()) as f32;
+        }
+        if let Some(m) = ahead {
+            r.range_m[0] = m as f32;
+        }
+        r
+    };
+    let mut a = PanicAvoid::new(P);
+    let mut k = 0;
+    while !a.evading() {
+        let t = 0.15 * k as f64;
+        a.on_odometry(&odo(t, 0.0, false, 7));
+        a.on_ring(&noisy(t, Some(3.5 - 0.6 * t)));
+        k += 1;
+        assert!(k < 30, "never fired");
+    }
+    let mut last = a.on_odometry(&odo(0.15 * k as f64, 0.0, false, 7)).expect("turns").command_id;
+    let turned = 0.15 * k as f64;
+    let (mut steps, mut held_until, mut sent) = (Vec::new(), turned, turned);
+    for j in k..k + 100 {
+        let t = 0.15 * j as f64;
+        assert_eq!(a.on_ring(&noisy(t, None)), None, "no new evasion from noise, at {t} s");
+        // Each step the reflex sends takes a second.
+        if let Some(c) = a.on_odometry(&odo(t + 0.05, 0.0, t < sent + 1.0, last)) {
+            (last, sent) = (c.command_id, t);
+            steps.push(c.kind());
+        }
+        if a.evading() {
+            held_until = t;
+        }
+    }
+    assert_eq!(a.episodes, 1);
+    (steps, held_until - turned)
+}
+
+#[test]
+fn a_step_runs_to_its_end_while_odometry_names_a_refused_command() {
+    let mut a = PanicAvoid::new(P);
+    let mut k = 0;
+    while !a.evading() {
+        let t = 0.15 * k as f64;
+        a.on_odometry(&odo(t, 0.0, false, 7));
+        a.on_ring(&ring(t, (3.0 - 0.6 * t) as f32, 4.0, 1.0));
+        k += 1;
+        assert!(k < 20, "never fired");
+    }
+    let turn = a.on_odometry(&odo(2.0, 0.0, false, 7)).expect("turns");
+    // The executive goes on publishing (the bridge refuses it): odometry names its command 8,
+    // not accepted, while the vehicle turns for three seconds.
+    let refused = |t: f64, moving: bool| Odometry { command_accepted: 0, ..odo(t, 0.0, moving, 8) };
+    for j in 1..=30 {
+        let t = 2.0 + 0.1 * f64::from(j);
+        assert_eq!(a.on_odometry(&refused(t, true)), None, "turning, at {t} s: nothing sent again");
+    }
+    let dash = a.on_odometry(&refused(5.1, false)).expect("the turn is over: the dash");
+    assert_eq!(dash.kind(), Some(CommandKind::Move));
+    assert_ne!(dash.command_id, turn.command_id);
+}
