@@ -4,16 +4,19 @@
 //! line, whatever carries the line and the topics.
 
 mod args;
+mod latch;
 pub mod link;
 pub mod resume;
 pub mod watchdog;
 
 pub use args::Args;
+pub use latch::PanicLatch;
 pub use resume::{BridgeState, Source};
 pub use watchdog::{SHUTDOWN_STOP_ID, WATCHDOG_STOP_ID, Watchdog};
 
 use harvey_drv_protocol::{Command, NakReason, Report};
 use harvey_msgs::{CommandKind, EncodersRaw, Header, MotionCommand, SonarRaw};
+use latch::forward;
 
 use harvey_geometry::FT;
 /// Longest MOVE the bridge sends: the DRV's limit, in feet.
@@ -35,51 +38,8 @@ pub enum Refusal {
     OutOfRange { id: u32, field: &'static str, value: f64, limit: f64 },
     #[error("command {id}: a panic-stop is in force until t = {until_ns} ns")]
     PanicStop { id: u32, until_ns: u64 },
-}
-
-/// The panic-stop's hold on the vehicle (001 §6.2): after an urgent stop, commands that would
-/// drive it forward, stamped within `hold_ns` of it, are refused (unless urgent themselves: the
-/// panic-avoid's), so that no old or new motion command slips in while the sonar keeps
-/// reporting the obstacle ahead (it re-sends the stop with every ring). Turning on the spot and
-/// backing away are let through: without them a robot stopped before a wall would stay there.
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
-pub struct PanicLatch {
-    hold_ns: u64,
-    until_ns: Option<u64>,
-}
-
-impl PanicLatch {
-    pub fn new(hold_ns: u64) -> Self {
-        Self { hold_ns, until_ns: None }
-    }
-
-    /// Lets a command through, or refuses it while a panic-stop holds.
-    pub fn admit(&mut self, cmd: &MotionCommand) -> Result<(), Refusal> {
-        let stop = cmd.kind() == Some(CommandKind::Stop);
-        if stop && cmd.urgent != 0 {
-            let until = cmd.header.stamp_ns.saturating_add(self.hold_ns);
-            self.until_ns = Some(self.until_ns.map_or(until, |u| u.max(until)));
-            return Ok(());
-        }
-        match self.until_ns {
-            // The panic-avoid's urgent motion overrides the hold (001 §6.2: the panic motor
-            // commands override any others).
-            Some(until_ns) if forward(cmd) && cmd.urgent == 0 && cmd.header.stamp_ns <= until_ns => {
-                Err(Refusal::PanicStop { id: cmd.command_id, until_ns })
-            }
-            _ => Ok(()),
-        }
-    }
-}
-
-/// Whether a command would move the vehicle forward (a stop or a turn on the spot would not).
-fn forward(cmd: &MotionCommand) -> bool {
-    match cmd.kind() {
-        Some(CommandKind::Move) => cmd.distance_m > 0.0,
-        Some(CommandKind::Velocity) => cmd.linear_mps > 0.0,
-        Some(CommandKind::Stop | CommandKind::Turn) => false,
-        None => true,
-    }
+    #[error("command {id}: the panic-avoid has the vehicle (its command {reflex})")]
+    Evading { id: u32, reflex: u32 },
 }
 
 /// Converts a bus command to the DRV's, or says why it must not be sent.
@@ -119,16 +79,17 @@ pub fn to_drv(cmd: &MotionCommand) -> Result<Command, Refusal> {
 }
 
 /// Picks what to send from a batch of commands that arrived together: an urgent stop pre-empts
-/// every command in the batch that would drive the vehicle forward, and goes first (turns on
-/// the spot and backing away follow it, as the panic-stop's hold lets them); otherwise all, in
-/// order.
+/// every command in the batch that would drive the vehicle forward, and goes first; the other
+/// reflexes' commands (the panic-avoid's stop, which starts its evasion, at the stamp of the
+/// panic-stop's) and the executive's turns on the spot and backing away follow it, as the
+/// panic-stop's hold lets them; otherwise all, in order.
 pub fn prioritise(batch: &[MotionCommand]) -> Vec<MotionCommand> {
-    match batch.iter().find(|c| c.urgent != 0 && c.kind() == Some(CommandKind::Stop)) {
-        Some(stop) => std::iter::once(*stop)
-            .chain(batch.iter().filter(|c| c.kind() != Some(CommandKind::Stop) && !forward(c)).copied())
-            .collect(),
-        None => batch.to_vec(),
-    }
+    let urgent_stop = |c: &MotionCommand| c.urgent != 0 && c.kind() == Some(CommandKind::Stop);
+    let Some(first) = batch.iter().position(urgent_stop) else { return batch.to_vec() };
+    let follows = |c: &MotionCommand| c.urgent != 0 || (c.kind() != Some(CommandKind::Stop) && !forward(c));
+    std::iter::once(batch[first])
+        .chain(batch.iter().enumerate().filter(|&(i, c)| i != first && follows(c)).map(|(_, c)| *c))
+        .collect()
 }
 
 /// A report turned into a bus message.
@@ -243,39 +204,9 @@ mod tests {
         let turn = cmd(CommandKind::Turn, 0.0, 0.5);
         assert_eq!(prioritise(&[mv, turn, stop]), vec![stop, turn], "a turn on the spot stays");
         assert_eq!(prioritise(&[mv, mv]).len(), 2);
-    }
-
-    #[test]
-    fn a_panic_stop_holds_motion_until_the_obstacle_is_gone() {
-        let mut latch = PanicLatch::new(200_000_000);
-        let at = |c: MotionCommand, stamp_ns| MotionCommand { header: Header::new(1, stamp_ns), ..c };
-        let mv = cmd(CommandKind::Move, 1.0, 0.0);
-        let panic = MotionCommand { urgent: 1, ..cmd(CommandKind::Stop, 0.0, 0.0) };
-        assert_eq!(latch.admit(&at(mv, 1_000)), Ok(()));
-        assert_eq!(latch.admit(&at(panic, 1_000_000_000)), Ok(()));
-        assert!(matches!(
-            latch.admit(&at(mv, 1_100_000_000)),
-            Err(Refusal::PanicStop { until_ns: 1_200_000_000, .. })
-        ));
-        // The sonar repeats the stop while the obstacle stays: the hold extends.
-        assert_eq!(latch.admit(&at(panic, 1_150_000_000)), Ok(()));
-        assert!(latch.admit(&at(mv, 1_300_000_000)).is_err());
-        assert_eq!(
-            latch.admit(&at(cmd(CommandKind::Stop, 0.0, 0.0), 1_300_000_000)),
-            Ok(()),
-            "plain stops always pass"
-        );
-        let evade = MotionCommand { urgent: 1, ..cmd(CommandKind::Turn, 0.0, 1.57) };
-        assert_eq!(latch.admit(&at(evade, 1_310_000_000)), Ok(()), "the panic-avoid's urgent turn passes");
-        assert_eq!(latch.admit(&at(mv, 1_400_000_000)), Ok(()), "obstacle gone: motion resumes");
-        // Held again: turning on the spot and backing away pass, driving on does not.
-        latch.admit(&at(panic, 2_000_000_000)).expect("the stop");
-        assert_eq!(latch.admit(&at(cmd(CommandKind::Turn, 0.0, 1.0), 2_050_000_000)), Ok(()));
-        assert_eq!(latch.admit(&at(cmd(CommandKind::Move, -0.3, 0.0), 2_060_000_000)), Ok(()));
-        let back = MotionCommand { linear_mps: -0.1, ..cmd(CommandKind::Velocity, 0.0, 0.0) };
-        assert_eq!(latch.admit(&at(back, 2_070_000_000)), Ok(()));
-        let on = MotionCommand { linear_mps: 0.1, ..back };
-        assert!(latch.admit(&at(on, 2_080_000_000)).is_err());
+        // The panic-stop's and the panic-avoid's stops of one ring: both go.
+        let evade = MotionCommand { command_id: 9, ..stop };
+        assert_eq!(prioritise(&[stop, evade, mv, cmd(CommandKind::Stop, 0.0, 0.0)]), vec![stop, evade]);
     }
 
     #[test]

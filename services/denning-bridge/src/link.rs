@@ -10,7 +10,7 @@ use harvey_drv_protocol::{Command, Decoder, Line, encode};
 use harvey_msgs::{EncodersRaw, MotionCommand, SonarRaw};
 use harvey_runtime::{Checkpoint, Rosout};
 
-use crate::{BridgeState, Outgoing, Source, WATCHDOG_STOP_ID, prioritise, to_drv};
+use crate::{BridgeState, Outgoing, Refusal, Source, WATCHDOG_STOP_ID, prioritise, to_drv};
 
 /// Why the loop over one connection ended.
 pub enum Ended {
@@ -80,6 +80,8 @@ pub fn forward<P: Write>(
                 link.send_raw(&frame)?;
                 round.push(frame);
             }
+            // The executive's commands while the panic-avoid evades: expected, many a second.
+            Err(refusal @ Refusal::Evading { .. }) => tracing::debug!("refused: {refusal}"),
             Err(refusal) => tracing::error!("refused: {refusal}"),
         }
     }
@@ -141,7 +143,10 @@ pub fn publish<P: Write>(
     line: Line,
 ) -> anyhow::Result<()> {
     let out = match line {
-        Line::Report(r) => link.state.bridge.on_report(r),
+        Line::Report(r) => {
+            link.state.latch.on_report(&r);
+            link.state.bridge.on_report(r)
+        }
         Line::Tick { time_ms } => Outgoing::Tick { time_ms },
         line @ (Line::Command(_) | Line::Sync { .. } | Line::Heartbeat { .. }) => {
             tracing::warn!(?line, "ignoring a host frame echoed by the vehicle");

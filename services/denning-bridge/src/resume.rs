@@ -4,7 +4,7 @@
 //! The whole state is checkpointed by `main.rs` at every change; nothing here does IO.
 
 use harvey_drv_protocol::{Line, Report};
-use harvey_msgs::{Header, MotionCommand};
+use harvey_msgs::MotionCommand;
 
 use crate::{Bridge, PanicLatch, Watchdog};
 
@@ -28,9 +28,17 @@ pub struct BridgeState {
     encoders_ms: Option<u64>,
     sonar_ms: Option<u64>,
     tick_ms: Option<u64>,
-    /// (stamp, seq) of the newest command forwarded from each source.
-    commands: Option<(u64, u64)>,
-    reflexes: Option<(u64, u64)>,
+    /// The newest stamp among the commands forwarded from each source, and the ids forwarded
+    /// at that stamp.
+    commands: Newest,
+    reflexes: Newest,
+}
+
+/// The newest stamp a source's commands were forwarded at, and which ids were.
+#[derive(Debug, Default, serde::Serialize, serde::Deserialize)]
+struct Newest {
+    stamp_ns: Option<u64>,
+    ids: Vec<u32>,
 }
 
 impl BridgeState {
@@ -44,8 +52,8 @@ impl BridgeState {
             encoders_ms: None,
             sonar_ms: None,
             tick_ms: None,
-            commands: None,
-            reflexes: None,
+            commands: Newest::default(),
+            reflexes: Newest::default(),
         }
     }
 
@@ -62,18 +70,27 @@ impl BridgeState {
     }
 
     /// Whether a command is news: a restarted bridge's subscriber is handed the newest command
-    /// again (the topic's history), which its predecessor may already have forwarded.
+    /// again (the topic's history), which its predecessor may already have forwarded. Known by
+    /// its stamp and id, not its sequence number: the reflexes' topic has two senders (the
+    /// panic-stop and the panic-avoid) numbering their own, often at the same stamp.
     pub fn fresh_command(&mut self, source: Source, cmd: &MotionCommand) -> bool {
-        let slot = match source {
+        let newest = match source {
             Source::Commands => &mut self.commands,
             Source::Reflexes => &mut self.reflexes,
         };
-        let Header { seq, stamp_ns } = cmd.header;
-        if slot.is_some_and(|last| (stamp_ns, seq) <= last) {
-            return false;
+        let (stamp_ns, id) = (cmd.header.stamp_ns, cmd.command_id);
+        match newest.stamp_ns {
+            Some(last) if stamp_ns < last => false,
+            Some(last) if stamp_ns == last && newest.ids.contains(&id) => false,
+            Some(last) if stamp_ns == last => {
+                newest.ids.push(id);
+                true
+            }
+            _ => {
+                (newest.stamp_ns, newest.ids) = (Some(stamp_ns), vec![id]);
+                true
+            }
         }
-        *slot = Some((stamp_ns, seq));
-        true
     }
 
     /// Whether the chain's tick `t` still needs its `SY` (a resumed chain may report a tick
@@ -94,12 +111,13 @@ fn newer(slot: &mut Option<u64>, t: u64) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use harvey_msgs::CommandKind;
+    use harvey_msgs::{CommandKind, Header};
 
     fn cmd(seq: u64, stamp_ns: u64) -> MotionCommand {
         MotionCommand {
             header: Header::new(seq, stamp_ns),
             kind: CommandKind::Stop as u32,
+            command_id: seq as u32,
             ..Default::default()
         }
     }
@@ -135,6 +153,11 @@ mod tests {
         assert!(s.fresh_command(Source::Commands, &cmd(4, 1_000)));
         assert!(!s.fresh_command(Source::Commands, &cmd(4, 1_000)));
         assert!(s.fresh_command(Source::Reflexes, &cmd(4, 1_000)), "each source numbers its own");
+        // The panic-avoid's stop at the stamp of the panic-stop's, numbered lower by its sender.
+        let evade = MotionCommand { command_id: harvey_msgs::REFLEX_ID_BIT | 1, ..cmd(1, 1_000) };
+        assert!(s.fresh_command(Source::Reflexes, &evade), "another sender at the same stamp");
+        assert!(!s.fresh_command(Source::Reflexes, &evade));
+        assert!(!s.fresh_command(Source::Reflexes, &cmd(3, 900)), "older");
         // A restarted executive numbers from 1 again, later.
         assert!(s.fresh_command(Source::Commands, &cmd(1, 2_000)));
         assert!(!s.needs_sync(0) || s.synced.is_none());
