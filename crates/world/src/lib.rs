@@ -20,7 +20,7 @@ pub use check::Inconsistency;
 pub use load::{WorldError, load_str};
 pub use model::*;
 pub use movers::{Mover, load_movers, parse_movers};
-pub use poles::{Pole, PoleError, PoleField};
+pub use poles::{Pillar, Pole, PoleError, PoleField};
 pub use raycast::Hit;
 pub use topology::{Door, Landmark, LandmarkClass, Locale, Meadow, Strategy};
 

@@ -206,6 +206,9 @@ pub struct World {
     pub(crate) movers: Vec<crate::Mover>,
     #[serde(skip)]
     pub(crate) static_walls: usize,
+    /// Round pillars put down (the poles): drawn as eight walls each, echoing as cylinders.
+    #[serde(skip)]
+    pub(crate) pillars: Vec<crate::Pillar>,
 }
 
 impl World {

@@ -34,6 +34,13 @@ pub struct PoleField {
     pub visit_m: f64,
 }
 
+/// A round pillar standing in the world: where its centre is and its radius.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pillar {
+    pub at: [f64; 2],
+    pub radius_m: f64,
+}
+
 /// One pole put down: its code and where its centre is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pole {
@@ -86,6 +93,13 @@ fn to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 }
 
 impl World {
+    /// The round pillars put down ([`World::place_poles`]), for the sonar: a real pole returns
+    /// an echo from the point of it nearest the sensor, which the eight faces it is drawn with
+    /// do not when the beam meets them obliquely.
+    pub fn pillars(&self) -> &[Pillar] {
+        &self.pillars
+    }
+
     /// Puts the `[poles]` down for `seed` (none without the table) and returns them, code order.
     /// Call before adding movers: the poles are static walls.
     pub fn place_poles(&mut self, seed: u64) -> Result<Vec<Pole>, PoleError> {
@@ -116,6 +130,7 @@ impl World {
         let across = f.side_m / 2.0 / (std::f64::consts::PI / 8.0).cos();
         let face = 2.0 * across * (std::f64::consts::PI / 8.0).sin();
         for p in &placed {
+            self.pillars.push(Pillar { at: p.at, radius_m: f.side_m / 2.0 });
             let corners: Vec<[f64; 2]> = (0..8)
                 .map(|k| {
                     let a = (f64::from(k) + 0.5) * std::f64::consts::FRAC_PI_4;
