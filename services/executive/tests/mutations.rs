@@ -82,6 +82,7 @@ const NON_NEGATIVE: &[&str] = &[
     "timer_slack_s",
     "beacon_wait_s",
     "back_off_s",
+    "lost_after_s",
 ];
 
 /// Whether `value` at `n` is outside every range the key may have. Positions, headings, moves,

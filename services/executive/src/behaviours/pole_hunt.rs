@@ -60,6 +60,8 @@ pub struct PoleHunt {
     estimate: [f64; 2],
     timer_ns: u64,
     beacon_until_ns: u64,
+    /// q3: since when no echo has come from towards the pole.
+    silent_since_ns: Option<u64>,
     /// Codes parked by, in order.
     pub visited: Vec<u32>,
     pub done: Option<bool>,
@@ -105,6 +107,7 @@ impl PoleHunt {
             estimate: [start.x_m, start.y_m],
             timer_ns: 0,
             beacon_until_ns: 0,
+            silent_since_ns: None,
             visited: Vec::new(),
             done: None,
         }
@@ -244,14 +247,31 @@ impl PoleHunt {
                         .filter(|(b, _)| wrap(b - bearing).abs() <= 30f64.to_radians())
                         .min_by(|a, b| a.1.total_cmp(&b.1))
                 });
-                match nearest {
+                let echo = nearest.filter(|&(_, r)| r <= self.g.lost_m);
+                self.silent_since_ns = if echo.is_some() { None } else { self.silent_since_ns.or(Some(now)) };
+                match echo {
                     Some((_, r)) if r <= self.g.park_m => self.park(true),
-                    Some((b, r)) if r <= self.g.lost_m => {
+                    Some((b, r)) => {
                         let echo = here.plus(V2::new(b.cos(), b.sin()).scale(r));
                         parts[0] =
                             move_to_goal(here, echo, self.g.controlled_mps.min(r - self.g.park_m + 0.02));
                     }
-                    _ => self.park(false),
+                    // A sensor's reading lost now and then (a dropout, an echo gone another
+                    // way) is not the pole gone: the robot waits still for the next readings.
+                    None if now
+                        < self.silent_since_ns.unwrap_or(now) + (self.g.lost_after_s * 1e9) as u64 =>
+                    {
+                        spin = Some(0.0);
+                    }
+                    None => {
+                        tracing::debug!(
+                            ?nearest,
+                            goal = ?(goal.x, goal.y),
+                            here = ?(here.x, here.y),
+                            "parking: no echo towards the pole within reach"
+                        );
+                        self.park(false)
+                    }
                 }
             }
             _ => {}
@@ -285,6 +305,7 @@ impl PoleHunt {
 
     /// q3 is over (parked or the pole lost): q4, then the next pole.
     fn park(&mut self, parked: bool) {
+        self.silent_since_ns = None;
         self.seq.trigger(if parked { Trigger::Terminal } else { Trigger::Recoverable });
         if let Some(code) = self.target.take().filter(|_| parked) {
             tracing::info!(code, visited = self.visited.len() + 1, "parked by a pole");

@@ -104,6 +104,7 @@ pub(crate) fn check_poles(k: &KeyPath, p: &PolesGoal) -> Result<(), OutOfRange> 
     check(&k.key("back_off_s"), p.back_off_s, &WAIT)?;
     check(&k.key("park_m"), p.park_m, &LENGTH)?;
     check(&k.key("lost_m"), p.lost_m, &LENGTH)?;
+    check(&k.key("lost_after_s"), p.lost_after_s, &WAIT)?;
     check(&k.key("ballistic_mps"), p.ballistic_mps, &SPEED)?;
     check(&k.key("controlled_mps"), p.controlled_mps, &SPEED)?;
     check(&k.key("max_turn_degps"), p.max_turn_degps, &TURN_RATE)?;

@@ -135,9 +135,10 @@ pub struct PolesGoal {
     /// After parking, back away for this long (at the controlled speed) before looking again.
     pub back_off_s: f64,
     /// q3: parked when the nearest echo towards the pole is this far from the robot's centre;
-    /// no echo within `lost_m` in that direction and the pole is lost.
+    /// no echo within `lost_m` in that direction for `lost_after_s` and the pole is lost.
     pub park_m: f64,
     pub lost_m: f64,
+    pub lost_after_s: f64,
     /// Speeds (m/s), turn rate (degrees/s) and its gain (per second).
     pub ballistic_mps: f64,
     pub controlled_mps: f64,
