@@ -218,8 +218,8 @@ impl PanicAvoid {
         let confirmed = |i: usize| self.approach.streak(i) >= self.p.confirm;
         // "Until no sensor senses the object approaching" (001 §6.2), on the evidence that
         // starts an evasion: several confirming readings of one sensor. A single reading closing
-        // somewhere on the ring is not that: with 3 cm of range noise one of 24 sensors nearly
-        // always shows one, and the robot held still for the rest of its run.
+        // somewhere on the ring is not that: with 3 cm of range noise one of 24 sensors shows
+        // one on most rings, and the robot dashed again after every dash.
         self.approaching = (0..SONAR_SENSORS).any(confirmed);
         let trigger = (0..SONAR_SENSORS).any(|i| {
             let b = bearing_rad(i);
