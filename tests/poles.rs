@@ -53,3 +53,27 @@ fn nine_or_more_of_the_ten_poles_are_visited_within_twenty_minutes() {
     assert!(trace.iter().filter(|&&q| q == 4).count() >= parked as usize);
     assert!(trace.windows(5).filter(|w| w == &[0, 1, 2, 3, 4]).count() >= 9, "{trace:?}");
 }
+
+/// The count after `key` in a run's summary line (`poles visited 10 of 10`, `achieved 10`).
+fn count_after(stdout: &str, key: &str) -> usize {
+    let at = stdout.find(key).unwrap_or_else(|| panic!("no `{key}` in the summary:\n{stdout}")) + key.len();
+    stdout[at..].split(|c: char| !c.is_ascii_digit()).next().and_then(|n| n.parse().ok()).expect("a count")
+}
+
+#[test]
+fn under_harsh_sensors_nine_or_more_poles_are_parked_by_over_seeds() {
+    // The harsh condition (conditions/harsh.toml): 5 % sonar dropouts, crosstalk and multipath,
+    // 0.1 ft range noise, a dim noisy soft camera 10 mrad off. `harvey sweep missions/poles.toml
+    // --seeds 1..10 --conditions nominal,dim,harsh` reaches the goal in every run
+    // (docs/evaluation.md); before the parking waited out a dropout, harsh parked by 4-5.
+    for seed in 1..=3 {
+        let out = common::run_mission_under("missions/poles.toml", "harsh", seed, "poles_harsh");
+        assert!(out.status.success() && out.stdout.contains("goal reached"), "harsh s{seed}: {}", out.stdout);
+        // Visits as the summary counts them from the recording: the true path against the
+        // poles the simulator put down.
+        let visited = count_after(&out.stdout, "poles visited ");
+        let parked = count_after(&out.stdout, "; achieved ");
+        assert!(visited >= 9, "harsh s{seed}: {visited} poles visited");
+        assert!(parked >= 9 && parked <= visited, "harsh s{seed}: claims {parked}, truth says {visited}");
+    }
+}
