@@ -164,6 +164,9 @@ impl PanicAvoid {
         let turn = self.away * self.p.turn_rad;
         match self.phase {
             // Away from the object (left is a positive turn).
+            // No room to dash that way (a hall's wall): turning would leave the robot facing
+            // it, the panic-stop holding it there; it keeps still instead.
+            Phase::Stopping if !self.moving && self.side_room() < MIN_DASH_M => Some(self.hold(t)),
             Phase::Stopping if !self.moving => Some(self.turn(t, turn)),
             Phase::Turning(step) if step.lost(o) => Some(self.turn(t, turn)),
             Phase::Dashing(step) if step.lost(o) => Some(self.dash(t, self.dash_room().max(0.0))),
@@ -194,6 +197,12 @@ impl PanicAvoid {
         let c = self.command(CommandKind::Turn, t, 0.0, angle_rad);
         self.phase = Phase::Turning(Step { id: c.command_id, sent_ns: t, moved: false });
         c
+    }
+
+    /// How far a dash could go after the turn: the clearance on the side turned to.
+    fn side_room(&self) -> f64 {
+        let side = if self.away > 0.0 { self.clearance[0] } else { self.clearance[1] };
+        (side - self.p.stop_m - DASH_MARGIN_M).min(self.p.dash_m)
     }
 
     /// How far a dash may go: its length, cut short of what is ahead.

@@ -258,3 +258,23 @@ fn a_step_runs_to_its_end_while_odometry_names_a_refused_command() {
     assert_eq!(dash.kind(), Some(CommandKind::Move));
     assert_ne!(dash.command_id, turn.command_id);
 }
+
+#[test]
+fn with_no_room_to_dash_either_way_the_robot_keeps_still_instead_of_turning() {
+    let mut a = PanicAvoid::new(P);
+    // Walls 0.7 m left and right: a dash needs 0.61 + 0.05 + 0.1 m.
+    let mut k = 0;
+    while !a.evading() {
+        let t = 0.15 * k as f64;
+        a.on_odometry(&odo(t, 0.0, false, 7));
+        a.on_ring(&ring(t, (3.0 - 0.6 * t) as f32, 0.7, 0.7));
+        k += 1;
+        assert!(k < 20, "never fired");
+    }
+    let hold = a.on_odometry(&odo(2.0, 0.0, false, 7)).expect("holds");
+    assert_eq!((hold.kind(), hold.urgent), (Some(CommandKind::Stop), 1));
+    // The object goes by: the hold ends, the robot never turned.
+    a.on_ring(&ring(2.1, 8.0, 0.7, 0.7));
+    assert_eq!(a.on_odometry(&odo(2.2, 0.0, false, hold.command_id)), None);
+    assert!(!a.evading());
+}
