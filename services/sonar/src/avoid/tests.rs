@@ -39,6 +39,20 @@ fn odo(t: f64, x: f64, moving: bool, id: u32) -> Odometry {
     }
 }
 
+/// The robot stands still (its last command 7); something comes at it from 3 m at 0.6 m/s,
+/// the walls `left` and `right` m away; until the reflex fires.
+fn bearing_down(a: &mut PanicAvoid, left: f32, right: f32) {
+    for k in 0..20 {
+        let t = 0.15 * f64::from(k);
+        a.on_odometry(&odo(t, 0.0, false, 7));
+        a.on_ring(&ring(t, (3.0 - 0.6 * t) as f32, left, right));
+        if a.evading() {
+            return;
+        }
+    }
+    panic!("never fired");
+}
+
 #[test]
 fn driving_at_a_wall_is_no_approach() {
     let mut a = PanicAvoid::new(P);
@@ -157,14 +171,7 @@ fn a_spurious_reading_or_a_slow_drift_does_not_trigger() {
 #[test]
 fn a_refused_turn_is_sent_again() {
     let mut a = PanicAvoid::new(P);
-    let mut k = 0;
-    while !a.evading() {
-        let t = 0.15 * k as f64;
-        a.on_odometry(&odo(t, 0.0, false, 7));
-        a.on_ring(&ring(t, (3.0 - 0.6 * t) as f32, 4.0, 1.0));
-        k += 1;
-        assert!(k < 20, "never fired");
-    }
+    bearing_down(&mut a, 4.0, 1.0);
     let turn = a.on_odometry(&odo(2.0, 0.0, false, 7)).expect("turns");
     assert!(turn.angle_rad > 0.0, "left is clearer");
     assert_eq!(a.on_odometry(&odo(2.5, 0.0, false, 7)), None, "give it time");
@@ -238,14 +245,7 @@ fn evade_then_noise(draw: u64) -> (Vec<Option<CommandKind>>, f64) {
 #[test]
 fn a_step_runs_to_its_end_while_odometry_names_a_refused_command() {
     let mut a = PanicAvoid::new(P);
-    let mut k = 0;
-    while !a.evading() {
-        let t = 0.15 * k as f64;
-        a.on_odometry(&odo(t, 0.0, false, 7));
-        a.on_ring(&ring(t, (3.0 - 0.6 * t) as f32, 4.0, 1.0));
-        k += 1;
-        assert!(k < 20, "never fired");
-    }
+    bearing_down(&mut a, 4.0, 1.0);
     let turn = a.on_odometry(&odo(2.0, 0.0, false, 7)).expect("turns");
     // The executive goes on publishing (the bridge refuses it): odometry names its command 8,
     // not accepted, while the vehicle turns for three seconds.
@@ -263,14 +263,7 @@ fn a_step_runs_to_its_end_while_odometry_names_a_refused_command() {
 fn with_no_room_to_dash_either_way_the_robot_keeps_still_instead_of_turning() {
     let mut a = PanicAvoid::new(P);
     // Walls 0.7 m left and right: a dash needs 0.61 + 0.05 + 0.1 m.
-    let mut k = 0;
-    while !a.evading() {
-        let t = 0.15 * k as f64;
-        a.on_odometry(&odo(t, 0.0, false, 7));
-        a.on_ring(&ring(t, (3.0 - 0.6 * t) as f32, 0.7, 0.7));
-        k += 1;
-        assert!(k < 20, "never fired");
-    }
+    bearing_down(&mut a, 0.7, 0.7);
     let hold = a.on_odometry(&odo(2.0, 0.0, false, 7)).expect("holds");
     assert_eq!((hold.kind(), hold.urgent), (Some(CommandKind::Stop), 1));
     // The object goes by: the hold ends, the robot never turned.
