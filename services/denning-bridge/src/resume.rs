@@ -87,7 +87,9 @@ impl BridgeState {
                 true
             }
             _ => {
-                (newest.stamp_ns, newest.ids) = (Some(stamp_ns), vec![id]);
+                newest.stamp_ns = Some(stamp_ns);
+                newest.ids.clear();
+                newest.ids.push(id);
                 true
             }
         }
