@@ -42,6 +42,7 @@ pub fn bench_stereo(world: &World, left: &GrayBuf, size: &str, rows: &mut Vec<Ro
         far_m: 12.0,
         patch: 9,
         min_score: 0.98,
+        min_margin: 0.0,
         moravec: CORNERS,
     };
     let fb = p.focal_px * p.baseline_m;

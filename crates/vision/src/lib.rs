@@ -16,11 +16,13 @@ pub mod moravec;
 pub mod nc;
 mod nc_pass;
 pub mod noise;
+pub mod odometry;
 pub mod path;
 pub mod pyramid;
 pub mod regions;
 mod run_pass;
 pub mod simd;
 pub mod stereo;
+pub mod unique;
 
 pub use image::{Gray, GrayBuf, Rect, VisionError};

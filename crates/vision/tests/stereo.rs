@@ -35,6 +35,7 @@ fn params(w: &World, band_rows: usize) -> StereoParams {
         far_m: 12.0,
         patch: 9,
         min_score: 0.98,
+        min_margin: 0.0,
         moravec: MoravecParams { window: 5, threshold: 3000, suppress_radius: 4, max_corners: 150 },
     }
 }

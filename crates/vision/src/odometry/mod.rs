@@ -1,0 +1,228 @@
+//! Visual odometry by stereo, stop to stop (003, the CMU rover after Moravec's Cart): at the
+//! first stop the Moravec operator's features are ranged by stereo; at each next stop every
+//! feature is reacquired in the new left image inside the box the predicted motion and its
+//! margins allow, ranged again by stereo, features whose distances to the others changed are
+//! pruned (rigidity), and the motion is solved by weighted least squares with the prediction as
+//! a heavily weighted term, implausible residuals edited out one by one (Gennery). The features
+//! that held, topped up with new ones, are carried to the next stop.
+
+pub mod reacquire;
+pub mod rig;
+pub mod rigidity;
+pub mod solve;
+
+use crate::image::{Gray, GrayBuf, Rect, VisionError};
+use crate::nc::{Correlator, Template};
+use crate::stereo::{Stereo, StereoParams};
+pub use rig::Rig;
+pub use rigidity::Tolerance;
+pub use solve::{Motion, Pair, Prior, Solution};
+
+/// Everything the odometry needs to know; the numbers come from the mission's file.
+#[derive(Debug, Clone, PartialEq)]
+pub struct OdometryParams {
+    pub rig: Rig,
+    /// The stereo axis: band, near and far limits, patch, threshold, interest operator.
+    pub stereo: StereoParams,
+    /// The time axis: a reacquired patch must correlate at least this well.
+    pub track_min_score: f32,
+    /// The reacquisition box spans the prediction this many standard deviations either way.
+    pub box_sigmas: f64,
+    pub rigidity: Tolerance,
+    /// Gennery's editing drops a feature whose normalised squared residual exceeds this.
+    pub edit_chi2: f64,
+    /// No motion is solved on fewer features.
+    pub min_features: usize,
+    /// A new feature is taken only this far (pixels) from every carried one.
+    pub spacing_px: f32,
+}
+
+/// What a stop's solution rests on.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StepReport {
+    pub solution: Solution,
+    /// Features carried from the last stop, and how many were found again and ranged.
+    pub carried: usize,
+    pub reacquired: usize,
+    /// Dropped by the rigidity test.
+    pub pruned: usize,
+    /// The factor the stereo model's errors were scaled by, from the pairs' spread.
+    pub error_scale: f64,
+    /// Features carried to the next stop (those that held and new ones).
+    pub features: usize,
+}
+
+/// Why a stop gave no motion. The odometry starts afresh from the stop's images either way, so
+/// the next stop is solved against this one.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OdometryError {
+    #[error(transparent)]
+    Vision(#[from] VisionError),
+    #[error(
+        "no motion solution: {reacquired} of {carried} features found again, {left} after pruning and editing, {needed} needed"
+    )]
+    NoSolution { carried: usize, reacquired: usize, left: usize, needed: usize },
+    #[error("the stereo pair is {got:?}, the odometry started on {started:?}")]
+    SizeChanged { got: [usize; 2], started: [usize; 2] },
+}
+
+/// A feature carried from one stop to the next.
+#[derive(Debug, Clone)]
+struct Feature {
+    /// In the robot frame of the stop it was last seen at.
+    point: [f64; 3],
+    /// Where it was in that stop's left image, and the patch round it.
+    at: [f32; 2],
+    patch: GrayBuf,
+}
+
+/// The odometry with its features and buffers.
+#[derive(Debug)]
+pub struct VisualOdometry {
+    params: OdometryParams,
+    stereo: Stereo,
+    correlator: Correlator,
+    features: Vec<Feature>,
+    size: Option<[usize; 2]>,
+    pairs: Vec<Pair>,
+    found: Vec<Feature>,
+    scratch: Vec<bool>,
+}
+
+impl VisualOdometry {
+    pub fn new(params: OdometryParams) -> Self {
+        Self {
+            params,
+            stereo: Stereo::default(),
+            correlator: Correlator::default(),
+            features: Vec::new(),
+            size: None,
+            pairs: Vec::new(),
+            found: Vec::new(),
+            scratch: Vec::new(),
+        }
+    }
+
+    /// The features carried now: their left-image positions and robot-frame points.
+    pub fn features(&self) -> impl Iterator<Item = ([f32; 2], [f64; 3])> + '_ {
+        self.features.iter().map(|f| (f.at, f.point))
+    }
+
+    /// The first stop (or a fresh start): ranges the pair's features; returns how many.
+    pub fn start(&mut self, left: &Gray<'_>, right: &Gray<'_>) -> Result<usize, OdometryError> {
+        self.features.clear();
+        self.size = Some([left.width, left.height]);
+        self.top_up(left, right)?;
+        Ok(self.features.len())
+    }
+
+    /// The next stop, after a motion predicted as `prior`: the motion solved, or why not.
+    pub fn step(
+        &mut self,
+        left: &Gray<'_>,
+        right: &Gray<'_>,
+        prior: &Prior,
+    ) -> Result<StepReport, OdometryError> {
+        let got = [left.width, left.height];
+        match self.size {
+            Some(started) if started != got => return Err(OdometryError::SizeChanged { got, started }),
+            None => {
+                self.start(left, right)?;
+                return Err(self.no_solution(0, 0, 0));
+            }
+            Some(_) => {}
+        }
+        let carried = self.features.len();
+        self.reacquire(left, right, prior)?;
+        let reacquired = self.pairs.len();
+        let mut active = vec![true; reacquired];
+        let p = &self.params;
+        let pruned = rigidity::prune(&p.rig, &self.pairs, &mut active, p.rigidity, &mut self.scratch);
+        let variance = pruned.scale * pruned.scale;
+        for pair in &mut self.pairs {
+            pair.old_cov = pair.old_cov.map(|c| c * variance);
+            pair.new_cov = pair.new_cov.map(|c| c * variance);
+        }
+        let solved = solve::solve(&self.pairs, &mut active, prior, p.edit_chi2, p.min_features);
+        // The features that held go on; the odometry restarts from this stop if none did.
+        let mut held = std::mem::take(&mut self.found);
+        self.features.clear();
+        self.features.extend(held.drain(..).zip(&active).filter(|(_, a)| **a).map(|(f, _)| f));
+        self.found = held;
+        let solution = match solved {
+            Ok(s) => s,
+            Err(e) => {
+                self.start(left, right)?;
+                return Err(self.no_solution(carried, reacquired, e.left));
+            }
+        };
+        self.top_up(left, right)?;
+        Ok(StepReport {
+            solution,
+            carried,
+            reacquired,
+            pruned: pruned.dropped,
+            error_scale: pruned.scale,
+            features: self.features.len(),
+        })
+    }
+
+    fn no_solution(&self, carried: usize, reacquired: usize, left: usize) -> OdometryError {
+        OdometryError::NoSolution { carried, reacquired, left, needed: self.params.min_features }
+    }
+
+    /// Each carried feature looked for in its predicted box and ranged: `self.pairs` and, in
+    /// the same order, `self.found` (the features as seen at this stop).
+    fn reacquire(&mut self, left: &Gray<'_>, right: &Gray<'_>, prior: &Prior) -> Result<(), OdometryError> {
+        let p = &self.params;
+        let half = p.stereo.patch / 2;
+        self.pairs.clear();
+        self.found.clear();
+        for f in &self.features {
+            let size = [left.width, left.height];
+            let Some(window) = reacquire::predicted_box(&p.rig, f.point, prior, p.box_sigmas, size, half)
+            else {
+                continue;
+            };
+            let m = self.correlator.best(left, window, &Template::new(&f.patch)?)?;
+            if m.score < p.track_min_score {
+                continue;
+            }
+            let (x, y) = (m.x + half, m.y + half);
+            let Some(s) = self.stereo.match_at(left, right, x, y, &p.stereo)? else { continue };
+            let Some(point) = p.rig.triangulate(m.centre, s.disparity) else { continue };
+            self.pairs.push(Pair {
+                old: f.point,
+                new: point,
+                old_cov: p.rig.covariance(f.point),
+                new_cov: p.rig.covariance(point),
+            });
+            let patch = GrayBuf::crop(left, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?;
+            self.found.push(Feature { point, at: m.centre, patch });
+        }
+        Ok(())
+    }
+
+    /// New features ranged in the left image, away from those carried, up to the interest
+    /// operator's count in all.
+    fn top_up(&mut self, left: &Gray<'_>, right: &Gray<'_>) -> Result<(), OdometryError> {
+        let p = &self.params;
+        let half = p.stereo.patch / 2;
+        let spacing = p.spacing_px * p.spacing_px;
+        let matches = self.stereo.match_points(left, right, left.full(), &p.stereo)?;
+        for m in matches {
+            if self.features.len() >= p.stereo.moravec.max_corners {
+                break;
+            }
+            let near = |f: &Feature| (f.at[0] - m.left[0]).powi(2) + (f.at[1] - m.left[1]).powi(2) < spacing;
+            if self.features.iter().any(near) {
+                continue;
+            }
+            let Some(point) = p.rig.triangulate(m.left, m.disparity) else { continue };
+            let (x, y) = (m.left[0] as usize, m.left[1] as usize);
+            let patch = GrayBuf::crop(left, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?;
+            self.features.push(Feature { point, at: m.left, patch });
+        }
+        Ok(())
+    }
+}
