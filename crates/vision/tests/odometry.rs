@@ -9,7 +9,9 @@ use harvey_msgs::Encoding;
 use harvey_render::{Effects, Renderer, mount_error};
 use harvey_vision::Gray;
 use harvey_vision::moravec::MoravecParams;
-use harvey_vision::odometry::{Motion, OdometryError, OdometryParams, Prior, Rig, Tolerance, VisualOdometry};
+use harvey_vision::odometry::{
+    LucasParams, Motion, OdometryError, OdometryParams, Prior, Rig, Solver, Tolerance, VisualOdometry,
+};
 use harvey_vision::stereo::StereoParams;
 use harvey_world::{Pose2, World};
 
@@ -95,6 +97,7 @@ fn params(w: &World) -> OdometryParams {
         edit_chi2: 13.8,
         min_features: 8,
         spacing_px: 8.0,
+        solver: Solver::MatchThenSolve,
     }
 }
 
@@ -133,11 +136,11 @@ struct Figures {
 
 /// Runs the odometry over the seed's course: each step's prediction is the true motion with
 /// odometry's errors (3 % of the distance, a degree of heading), its margins a little wider.
-fn run(condition: &str, seed: u64) -> Figures {
+fn run(condition: &str, seed: u64, solver: Solver) -> Figures {
     let w = world(condition);
     let poses = course(seed, 21);
     let mut camera = StereoCamera::new(&w, seed);
-    let mut vo = VisualOdometry::new(params(&w));
+    let mut vo = VisualOdometry::new(OdometryParams { solver, ..params(&w) });
     let mut rng = Rng::new(seed ^ 0x5eed);
     let (l, r) = camera.pair(&w, poses[0], 0.0);
     let started = vo.start(&gray(&l), &gray(&r)).expect("starts");
@@ -186,7 +189,7 @@ fn stop_to_stop_motion_holds_over_seeds_and_conditions() {
     let mut misses = Vec::new();
     for condition in ["nominal", "dim", "harsh"] {
         for seed in 1..=8 {
-            let f = run(condition, seed);
+            let f = run(condition, seed, Solver::MatchThenSolve);
             println!(
                 "{condition:8} seed {seed}: {} steps over {:.2} m, {} unsolved, worst step {:.3} m {:.2} deg \
                  (predicted {:.3} m {:.2} deg), fewest features {}, position model {:.3} m off at the end",
@@ -249,4 +252,37 @@ fn a_blank_wall_gives_no_motion_solution_and_bad_pairs_are_refused() {
     assert_eq!(e.to_string(), "bad parameter: left and right images differ in size");
     let e = vo.step(&half, &half, &prior).expect_err("not the size it started on");
     assert_eq!(e.to_string(), "the stereo pair is [640, 240], the odometry started on [640, 480]");
+}
+
+/// 003's Lucas registration: four levels (the coarsest 80x60), 7x7 patches at each.
+const LUCAS: Solver = Solver::Lucas(LucasParams { levels: 4, radius: 3, iterations: 10, huber: 3.0 });
+
+/// Lucas registration on the same courses: it registers the steps more closely than matching
+/// one by one does (rigidity from the outset, as 003 hoped), but rests on the old stop's depths
+/// alone, so their scale error goes straight into the travel: its position model ends further
+/// off on some seeds (reported; held to 0.20 m so that it does not get worse unseen).
+#[test]
+fn lucas_registration_beside_match_then_solve() {
+    for condition in ["nominal", "dim", "harsh"] {
+        for seed in 1..=8 {
+            let f = run(condition, seed, LUCAS);
+            let m = run(condition, seed, Solver::MatchThenSolve);
+            println!(
+                "{condition:8} seed {seed}: worst step {:.3} m {:.2} deg, end {:.3} m (Lucas); \
+                 {:.3} m {:.2} deg, end {:.3} m (match then solve)",
+                f.worst_step_m,
+                f.worst_heading_rad.to_degrees(),
+                f.final_error_m,
+                m.worst_step_m,
+                m.worst_heading_rad.to_degrees(),
+                m.final_error_m
+            );
+            assert_eq!(f.failed, 0, "{condition} seed {seed}: every step registered");
+            assert!(
+                f.worst_step_m <= 0.05 && f.worst_heading_rad < 0.2f64.to_radians(),
+                "{condition} seed {seed}: {f:?}"
+            );
+            assert!(f.final_error_m <= 0.20, "{condition} seed {seed}: {f:?}");
+        }
+    }
 }

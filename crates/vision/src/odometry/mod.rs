@@ -4,8 +4,11 @@
 //! margins allow, ranged again by stereo, features whose distances to the others changed are
 //! pruned (rigidity), and the motion is solved by weighted least squares with the prediction as
 //! a heavily weighted term, implausible residuals edited out one by one (Gennery). The features
-//! that held, topped up with new ones, are carried to the next stop.
+//! that held, topped up with new ones, are carried to the next stop. Or, selectable, the
+//! motion comes from Lucas registration of the old stop's patches in the new image
+//! (`lucas.rs`), and the features are then reacquired where that motion puts them.
 
+pub mod lucas;
 pub mod reacquire;
 pub mod rig;
 pub mod rigidity;
@@ -13,7 +16,9 @@ pub mod solve;
 
 use crate::image::{Gray, GrayBuf, Rect, VisionError};
 use crate::nc::{Correlator, Template};
+use crate::pyramid::Pyramid;
 use crate::stereo::{Stereo, StereoParams};
+pub use lucas::LucasParams;
 pub use rig::Rig;
 pub use rigidity::Tolerance;
 pub use solve::{Motion, Pair, Prior, Solution};
@@ -35,6 +40,16 @@ pub struct OdometryParams {
     pub min_features: usize,
     /// A new feature is taken only this far (pixels) from every carried one.
     pub spacing_px: f32,
+    pub solver: Solver,
+}
+
+/// How the motion between stops is found (003 compares the two).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Solver {
+    /// Features matched one by one, then the motion solved on their 3-D points.
+    MatchThenSolve,
+    /// All patches registered at once on the images (Lucas).
+    Lucas(LucasParams),
 }
 
 /// What a stop's solution rests on.
@@ -87,6 +102,8 @@ pub struct VisualOdometry {
     pairs: Vec<Pair>,
     found: Vec<Feature>,
     scratch: Vec<bool>,
+    /// Lucas registration's pyramids of the last stop's left image and this one's.
+    pyramids: [Pyramid; 2],
 }
 
 impl VisualOdometry {
@@ -100,6 +117,7 @@ impl VisualOdometry {
             pairs: Vec::new(),
             found: Vec::new(),
             scratch: Vec::new(),
+            pyramids: [Pyramid::default(), Pyramid::default()],
         }
     }
 
@@ -112,6 +130,9 @@ impl VisualOdometry {
     pub fn start(&mut self, left: &Gray<'_>, right: &Gray<'_>) -> Result<usize, OdometryError> {
         self.features.clear();
         self.size = Some([left.width, left.height]);
+        if let Solver::Lucas(lp) = self.params.solver {
+            self.pyramids[0].build(left, lp.levels)?;
+        }
         self.top_up(left, right)?;
         Ok(self.features.len())
     }
@@ -133,7 +154,22 @@ impl VisualOdometry {
             Some(_) => {}
         }
         let carried = self.features.len();
-        self.reacquire(left, right, prior)?;
+        let registered = match self.params.solver {
+            Solver::MatchThenSolve => None,
+            Solver::Lucas(lp) => match self.register(left, prior, &lp) {
+                Ok(r) => Some(r),
+                Err(e) => {
+                    self.start(left, right)?;
+                    return Err(e);
+                }
+            },
+        };
+        // After a registration the features are looked for where its motion puts them.
+        let near = registered.as_ref().map(|r| Prior {
+            motion: r.motion,
+            sd: std::array::from_fn(|k| r.covariance[k][k].sqrt().max([0.01, 0.01, 0.005][k])),
+        });
+        self.reacquire(left, right, near.as_ref().unwrap_or(prior))?;
         let reacquired = self.pairs.len();
         let mut active = vec![true; reacquired];
         let p = &self.params;
@@ -143,7 +179,10 @@ impl VisualOdometry {
             pair.old_cov = pair.old_cov.map(|c| c * variance);
             pair.new_cov = pair.new_cov.map(|c| c * variance);
         }
-        let solved = solve::solve(&self.pairs, &mut active, prior, p.edit_chi2, p.min_features);
+        let solved = match registered {
+            None => solve::solve(&self.pairs, &mut active, prior, p.edit_chi2, p.min_features),
+            Some(r) => lucas_solution(r, &self.pairs, &active, p.min_features),
+        };
         // The features that held go on; the odometry restarts from this stop if none did.
         let mut held = std::mem::take(&mut self.found);
         self.features.clear();
@@ -165,6 +204,25 @@ impl VisualOdometry {
             error_scale: pruned.scale,
             features: self.features.len(),
         })
+    }
+
+    /// Lucas registration of the last stop's features in this stop's left image.
+    fn register(
+        &mut self,
+        left: &Gray<'_>,
+        prior: &Prior,
+        lp: &LucasParams,
+    ) -> Result<lucas::Registration, OdometryError> {
+        self.pyramids.swap(0, 1);
+        self.pyramids[0].build(left, lp.levels)?;
+        let anchors: Vec<lucas::Anchor> =
+            self.features.iter().map(|f| lucas::Anchor { at: f.at, point: f.point }).collect();
+        let [new, old] = &self.pyramids;
+        // The differences are weighed by the frame's own noise (a grey level at least).
+        let sd = f64::from(crate::noise::noise_sigma(left, left.full())).max(1.0);
+        lucas::register(&self.params.rig, &old.levels, &new.levels, &anchors, prior, lp, sd)
+            .filter(|r| r.patches >= self.params.min_features)
+            .ok_or_else(|| self.no_solution(anchors.len(), 0, 0))
     }
 
     fn no_solution(&self, carried: usize, reacquired: usize, left: usize) -> OdometryError {
@@ -225,4 +283,25 @@ impl VisualOdometry {
         }
         Ok(())
     }
+}
+
+/// A registration as a solution: the stereo pairs that held, and how well they agree with it.
+fn lucas_solution(
+    r: lucas::Registration,
+    pairs: &[Pair],
+    active: &[bool],
+    needed: usize,
+) -> Result<Solution, solve::TooFew> {
+    let held: Vec<&Pair> = pairs.iter().zip(active).filter(|(_, a)| **a).map(|(p, _)| p).collect();
+    if held.is_empty() {
+        return Err(solve::TooFew { left: 0, needed });
+    }
+    let sum: f64 = held.iter().map(|p| solve::residual(p, &r.motion).1).sum();
+    Ok(Solution {
+        motion: r.motion,
+        covariance: r.covariance,
+        edited: 0,
+        used: r.patches,
+        rms: (sum / held.len() as f64).sqrt(),
+    })
 }

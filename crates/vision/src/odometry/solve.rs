@@ -171,7 +171,7 @@ pub fn residual(pair: &Pair, motion: &Motion) -> ([f64; 2], f64) {
 }
 
 /// `h x = g` for a symmetric positive definite 3x3 `h` (Cholesky); `None` if it is not.
-fn solve3(h: [[f64; 3]; 3], g: [f64; 3]) -> Option<[f64; 3]> {
+pub(super) fn solve3(h: [[f64; 3]; 3], g: [f64; 3]) -> Option<[f64; 3]> {
     let mut l = [[0.0; 3]; 3];
     for i in 0..3 {
         for j in 0..=i {
@@ -198,7 +198,7 @@ fn solve3(h: [[f64; 3]; 3], g: [f64; 3]) -> Option<[f64; 3]> {
 }
 
 /// The inverse of a symmetric positive definite 3x3 matrix, column by column.
-fn inverse3(h: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+pub(super) fn inverse3(h: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let cols = [solve3(h, [1.0, 0.0, 0.0])?, solve3(h, [0.0, 1.0, 0.0])?, solve3(h, [0.0, 0.0, 1.0])?];
     Some(std::array::from_fn(|i| std::array::from_fn(|j| cols[j][i])))
 }
