@@ -8,10 +8,11 @@
 //!
 //! `taskset -c 0 cargo bench -p harvey-vision --bench kernels`; with `-- paths`, only the
 //! correlation and Moravec rows on every path the CPU has, against each other in one run
-//! (`paths.rs`).
+//! (`paths.rs`); with `-- odometry`, only the visual odometry's step (`odometry.rs`).
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "benchmark code")]
 
 mod geometry;
+mod odometry;
 mod paths;
 mod reference;
 mod reference_geometry;
@@ -87,6 +88,7 @@ fn path_of(kernel: &str) -> String {
         "Moravec",
         "coarse-to-fine",
         "stereo",
+        "visual odometry",
         "depth from motion",
         "activity",
         "fast line finder",
@@ -348,9 +350,13 @@ fn main() {
         return;
     }
     let mut rows = Vec::new();
-    // `hough`: the constrained Hough's rows alone.
+    // `hough`: the constrained Hough's rows alone; `odometry`: the visual odometry's.
     let hough_only = std::env::args().any(|a| a == "hough");
-    for (w, h) in [(640u32, 480u32), (256, 256)] {
+    let odometry_only = std::env::args().any(|a| a == "odometry");
+    if !hough_only {
+        odometry::bench_odometry(&world, &mut rows);
+    }
+    for (w, h) in [(640u32, 480u32), (256, 256)].into_iter().filter(|_| !odometry_only) {
         let img = frame(&world, w, h);
         write_pgm(&out.join(format!("frame_{w}x{h}.pgm")), &img);
         let size = format!("{w}x{h}");

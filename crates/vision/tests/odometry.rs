@@ -255,7 +255,7 @@ fn a_blank_wall_gives_no_motion_solution_and_bad_pairs_are_refused() {
 }
 
 /// 003's Lucas registration: four levels (the coarsest 80x60), 7x7 patches at each.
-const LUCAS: Solver = Solver::Lucas(LucasParams { levels: 4, radius: 3, iterations: 10, huber: 3.0 });
+const LUCAS: Solver = Solver::Lucas(LucasParams { levels: 4, radius: 3, iterations: 5, huber: 3.0 });
 
 /// Lucas registration on the same courses: it registers the steps more closely than matching
 /// one by one does (rigidity from the outset, as 003 hoped), but rests on the old stop's depths
