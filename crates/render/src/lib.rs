@@ -20,13 +20,14 @@ pub enum RenderError {
     NotFinite { pose: Pose2 },
 }
 
-/// One image column's ray: its direction and the wall it meets.
-#[derive(Debug, Clone, Copy, Default)]
+/// One image column's ray: its direction and the walls it meets.
+#[derive(Debug, Clone, Default)]
 struct Column {
     dir: [f64; 2],
     cos_off_axis: f64,
-    /// Depth along the optical axis of the wall hit, with the wall and position along it.
-    wall: Option<(f64, usize, f64)>,
+    /// Depth along the optical axis of each wall the ray meets, nearest first, with the wall
+    /// and the position along it: a row whose ray passes over a wall sees what is behind.
+    walls: Vec<(f64, usize, f64)>,
 }
 
 /// Renders frames of one size; keeps its per-column scratch so frames allocate nothing.
@@ -41,6 +42,7 @@ pub struct Renderer {
     yaw_rad: f64,
     pitch_rad: f64,
     columns: Vec<Column>,
+    hits: Vec<harvey_world::Hit>,
 }
 
 impl Renderer {
@@ -55,6 +57,7 @@ impl Renderer {
             yaw_rad: 0.0,
             pitch_rad: 0.0,
             columns: vec![Column::default(); width_px as usize],
+            hits: Vec::new(),
         }
     }
 
@@ -97,7 +100,7 @@ impl Renderer {
         let cx = f64::from(self.width_px) / 2.0;
         let aimed = Pose2 { heading_rad: heading + self.yaw_rad, ..pose };
         for (u, col) in self.columns.iter_mut().enumerate() {
-            *col = Column::cast(world, aimed, (cx - u as f64 - 0.5) / self.focal_px);
+            col.cast(world, aimed, (cx - u as f64 - 0.5) / self.focal_px, &mut self.hits);
         }
         let cam = &world.camera;
         let cy = f64::from(self.height_px) / 2.0;
@@ -124,38 +127,47 @@ impl Renderer {
 }
 
 impl Column {
-    /// The ray of the image column whose direction is `tan_left` (left positive) off the axis.
-    fn cast(world: &World, pose: Pose2, tan_left: f64) -> Self {
+    /// Casts the ray of the image column whose direction is `tan_left` (left positive) off the
+    /// axis; `hits` is scratch.
+    fn cast(&mut self, world: &World, pose: Pose2, tan_left: f64, hits: &mut Vec<harvey_world::Hit>) {
         let off_axis = tan_left.atan();
         let a = pose.heading_rad + off_axis;
-        let dir = [a.cos(), a.sin()];
-        let cos_off_axis = off_axis.cos();
-        let wall = world
-            .cast_ray([pose.x_m, pose.y_m], dir, 1e3)
-            .map(|h| (h.distance_m * cos_off_axis, h.wall, h.along_m));
-        Column { dir, cos_off_axis, wall }
+        self.dir = [a.cos(), a.sin()];
+        self.cos_off_axis = off_axis.cos();
+        world.cast_ray_all([pose.x_m, pose.y_m], self.dir, 1e3, hits);
+        self.walls.clear();
+        self.walls.extend(hits.iter().map(|h| (h.distance_m * self.cos_off_axis, h.wall, h.along_m)));
     }
 
     /// Reflectance and colour of what the ray `down` (image y over focal length) below the
     /// axis in this column meets first.
     fn appearance(&self, world: &World, origin: [f64; 2], down: f64) -> (f64, [f64; 3]) {
-        const WHITE: [f64; 3] = [1.0; 3];
-        let cam = &world.camera;
-        match self.wall {
-            Some((depth, wall, along)) => {
-                let z = cam.height_m - down * depth;
-                let w = &world.walls[wall];
-                if (0.0..=w.height_m).contains(&z) {
-                    w.appearance_at(along, z)
-                } else if z < 0.0 {
-                    (floor_at(world, origin, self, cam.height_m / down), WHITE)
-                } else {
-                    (world.floor.ceiling_reflectance, WHITE)
-                }
-            }
-            None if down > 0.0 => (floor_at(world, origin, self, cam.height_m / down), WHITE),
-            None => (world.floor.ceiling_reflectance, WHITE),
-        }
+        appearance(world, origin, self, self.walls.iter().copied(), down)
+    }
+}
+
+/// Reflectance and colour of what the ray `down` below the axis of `column` meets first among
+/// `walls` (depth along the axis, wall, position along it), the floor and the ceiling: the
+/// nearest wall met below its top, unless the ray reaches the floor before it. A row whose ray
+/// passes over a wall lower than the camera sees what is behind the wall.
+fn appearance(
+    world: &World,
+    origin: [f64; 2],
+    column: &Column,
+    walls: impl Iterator<Item = (f64, usize, f64)>,
+    down: f64,
+) -> (f64, [f64; 3]) {
+    const WHITE: [f64; 3] = [1.0; 3];
+    let h = world.camera.height_m;
+    // A wall is met where the ray is between the floor and the wall's top there; a wall met
+    // under the floor means the floor came first.
+    let seen = walls
+        .filter(|&(depth, wall, _)| (0.0..=world.walls[wall].height_m).contains(&(h - down * depth)))
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    match seen {
+        Some((depth, wall, along)) => world.walls[wall].appearance_at(along, h - down * depth),
+        None if down > 0.0 => (floor_at(world, origin, column, h / down), WHITE),
+        None => (world.floor.ceiling_reflectance, WHITE),
     }
 }
 
@@ -165,8 +177,14 @@ impl Column {
 pub fn reflectance_at(world: &World, pose: Pose2, width_px: u32, height_px: u32, u: f64, v: f64) -> f64 {
     let f = world.camera.focal_for(width_px);
     let (cx, cy) = (f64::from(width_px) / 2.0, f64::from(height_px) / 2.0);
-    let col = Column::cast(world, pose, (cx - u) / f);
-    col.appearance(world, [pose.x_m, pose.y_m], (v - cy) / f).0
+    // One ray, so its walls are taken as they come rather than kept: nothing is allocated.
+    let off_axis = ((cx - u) / f).atan();
+    let a = pose.heading_rad + off_axis;
+    let col = Column { dir: [a.cos(), a.sin()], cos_off_axis: off_axis.cos(), walls: Vec::new() };
+    let origin = [pose.x_m, pose.y_m];
+    let walls =
+        world.ray_hits(origin, col.dir, 1e3).map(|h| (h.distance_m * col.cos_off_axis, h.wall, h.along_m));
+    appearance(world, origin, &col, walls, (v - cy) / f).0
 }
 
 /// Reflectance of the floor tile seen at optical depth `depth_m` along a column.
@@ -213,6 +231,29 @@ mod tests {
         let f = w.camera.focal_px;
         let u = (320.0 - f * (1.0 / 2.45) - 0.5).round() as usize;
         assert_eq!(img[240 * 640 + u], lit(0.50), "column {u}");
+    }
+
+    #[test]
+    fn rows_passing_over_a_low_box_see_what_is_behind_it() {
+        let w = harvey_world::load_str(include_str!("../../../worlds/arena.toml"), "arena").expect("loads");
+        let mut r = Renderer::new(&w, 640, 480, Encoding::Mono8);
+        let mut img = vec![0u8; r.frame_bytes()];
+        // 1.7 m south of the cardboard box (0.7 m tall, faces at y = 7.7 and 8.3), facing north
+        // towards the arena's wall at y = 12 (2 m tall).
+        r.render(&w, Pose2::new(4.0, 6.0, std::f64::consts::FRAC_PI_2), &mut img).expect("renders");
+        let lit = |refl: f64| (w.camera.illumination * refl).round() as u8;
+        let at = |v: usize| img[v * 640 + 320];
+        // Row 420 meets the box's face 0.65 m up; row 300 passes over the box and meets the far
+        // wall 0.55 m up (it showed the ceiling before); row 380 passes over the box's near
+        // face, and its far face, seen from above, stands for the lid.
+        assert_eq!(at(420), lit(0.42));
+        assert_eq!(at(300), lit(0.50));
+        assert_eq!(at(380), lit(0.42));
+        // Row 355 passes over the box and reaches the floor before the far wall.
+        let f = w.camera.focal_px;
+        let floor_depth = w.camera.height_m / ((355.5 - 240.0) / f);
+        assert!(floor_depth > 2.3 && floor_depth < 6.0, "{floor_depth}");
+        assert!(w.floor.reflectance.iter().any(|&k| at(355) == lit(k)), "{}", at(355));
     }
 
     #[test]

@@ -16,33 +16,39 @@ pub struct Hit {
 impl World {
     /// The nearest wall hit by the ray from `origin` along unit direction `dir`, within `max_m`.
     pub fn cast_ray(&self, origin: [f64; 2], dir: [f64; 2], max_m: f64) -> Option<Hit> {
-        let mut best: Option<Hit> = None;
-        for (i, w) in self.walls.iter().enumerate() {
-            let e = [w.to[0] - w.from[0], w.to[1] - w.from[1]];
-            let denom = dir[0] * e[1] - dir[1] * e[0];
-            if denom.abs() < 1e-12 {
-                continue; // parallel
-            }
-            let d = [w.from[0] - origin[0], w.from[1] - origin[1]];
-            let t = (d[0] * e[1] - d[1] * e[0]) / denom; // along the ray
-            let s = (d[0] * dir[1] - d[1] * dir[0]) / denom; // along the wall, 0..1
-            if t <= 1e-9 || !(0.0..=1.0).contains(&s) || t > max_m {
-                continue;
-            }
-            if best.is_some_and(|b| b.distance_m <= t) {
-                continue;
-            }
-            let len = e[0].hypot(e[1]);
-            let cos_inc = (denom / len).abs(); // |dir x e| / |e| = |cos| of angle to normal
-            best = Some(Hit {
-                distance_m: t,
-                wall: i,
-                along_m: s * len,
-                incidence_rad: cos_inc.clamp(0.0, 1.0).acos(),
-            });
-        }
-        best
+        self.ray_hits(origin, dir, max_m).min_by(|a, b| a.distance_m.total_cmp(&b.distance_m))
     }
+
+    /// Every wall the ray meets within `max_m`, in the walls' order.
+    pub fn ray_hits(&self, origin: [f64; 2], dir: [f64; 2], max_m: f64) -> impl Iterator<Item = Hit> + '_ {
+        self.walls.iter().enumerate().filter_map(move |(i, w)| hit(i, w, origin, dir, max_m))
+    }
+
+    /// Every wall the ray meets within `max_m`, nearest first, into `out` (cleared first): what
+    /// a ray passing over a wall lower than itself meets next.
+    pub fn cast_ray_all(&self, origin: [f64; 2], dir: [f64; 2], max_m: f64, out: &mut Vec<Hit>) {
+        out.clear();
+        out.extend(self.ray_hits(origin, dir, max_m));
+        out.sort_by(|a, b| a.distance_m.total_cmp(&b.distance_m).then(a.wall.cmp(&b.wall)));
+    }
+}
+
+/// Where the ray meets wall `i`, if it does within `max_m`.
+fn hit(i: usize, w: &crate::Wall, origin: [f64; 2], dir: [f64; 2], max_m: f64) -> Option<Hit> {
+    let e = [w.to[0] - w.from[0], w.to[1] - w.from[1]];
+    let denom = dir[0] * e[1] - dir[1] * e[0];
+    if denom.abs() < 1e-12 {
+        return None; // parallel
+    }
+    let d = [w.from[0] - origin[0], w.from[1] - origin[1]];
+    let t = (d[0] * e[1] - d[1] * e[0]) / denom; // along the ray
+    let s = (d[0] * dir[1] - d[1] * dir[0]) / denom; // along the wall, 0..1
+    if t <= 1e-9 || !(0.0..=1.0).contains(&s) || t > max_m {
+        return None;
+    }
+    let len = e[0].hypot(e[1]);
+    let cos_inc = (denom / len).abs(); // |dir x e| / |e| = |cos| of angle to normal
+    Some(Hit { distance_m: t, wall: i, along_m: s * len, incidence_rad: cos_inc.clamp(0.0, 1.0).acos() })
 }
 
 #[cfg(test)]
