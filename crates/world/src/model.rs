@@ -163,6 +163,11 @@ pub struct Camera {
     /// Optical blur: a box filter of this radius in pixels (0: sharp).
     #[serde(default)]
     pub blur_px: u32,
+    /// A stereo pair (003): the distance between the two cameras, the left one half of it left
+    /// of the robot's centre line, the right one as far right; both as this camera, on one
+    /// mount. `None`: a single camera at the centre.
+    #[serde(default)]
+    pub stereo_baseline_m: Option<f64>,
 }
 
 fn default_illumination_period_s() -> f64 {
@@ -227,6 +232,17 @@ impl World {
     pub fn terrain_at(&self, x: f64, y: f64) -> &Terrain {
         // `load_str` rejects meadows whose terrain is not in the table.
         self.meadow_at(x, y).map_or(self.ground_terrain(), |m| &self.terrain[&m.terrain])
+    }
+
+    /// The diagonal of the walls' bounding box (m): nothing in the world is seen further away.
+    pub fn diagonal_m(&self) -> f64 {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in self.walls.iter().flat_map(|w| [w.from, w.to]) {
+            for k in 0..2 {
+                (lo[k], hi[k]) = (lo[k].min(p[k]), hi[k].max(p[k]));
+            }
+        }
+        if lo[0] > hi[0] { 0.0 } else { (hi[0] - lo[0]).hypot(hi[1] - lo[1]) }
     }
 
     /// The reflectances of the floor's checker pattern at `(x, y)`.

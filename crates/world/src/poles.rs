@@ -194,6 +194,8 @@ mod tests {
     #[test]
     fn a_field_too_small_for_its_poles_says_so() {
         let mut w = crate::load_str(include_str!("../../../worlds/arena.toml"), "arena.toml").expect("loads");
+        // The arena is 14 m by 12 m: nothing in it is seen further than its diagonal.
+        assert!((w.diagonal_m() - 14f64.hypot(12.0)).abs() < 1e-9, "{}", w.diagonal_m());
         let f = w.poles.as_mut().expect("a [poles] table");
         let [[x0, y0], _] = f.area_m;
         f.area_m[1] = [x0 + 0.01, y0 + 0.01];

@@ -240,7 +240,8 @@ impl Dispatcher {
                     self.frs.segment(&img, window, &ranges, area as u32).map_err(|e| status_of(&e))?;
                 let focal = self.world.camera.focal_for(w as u32);
                 self.poles.clear();
-                for pole in crate::poles::group(rings, field, focal, w as u32) {
+                let farthest = self.world.diagonal_m();
+                for pole in crate::poles::group(rings, field, focal, w as u32, farthest) {
                     self.poles.push(pole);
                 }
                 self.poles.sort_by(|a, b| a[1].total_cmp(&b[1]));

@@ -32,12 +32,14 @@ pub fn ring_threshold(img: &Gray<'_>, w: Rect, contrast: f32) -> u8 {
 
 /// The poles among `rings` (bright regions) of an image `image_width` wide, each `[u, range_m,
 /// code, v_top, v_bottom, 0]`. A column of other than three rings, whose middle ring is no code,
-/// or cut by the image's side, is not a pole.
+/// whose rings are more than twice as wide as the pole at its range (and 2 px), further than
+/// `farthest_m` (the world's diagonal), or cut by the image's side, is not a pole.
 pub fn group<'a>(
     rings: &'a [Region],
     f: &'a PoleField,
     focal_px: f64,
     image_width: u32,
+    farthest_m: f64,
 ) -> impl Iterator<Item = [f32; 6]> + 'a {
     rings.iter().enumerate().filter_map(move |(i, seed)| {
         if seed.bbox[0] == 0 || seed.bbox[2] + 1 >= image_width {
@@ -70,6 +72,17 @@ pub fn group<'a>(
         let height = f.bottom_m + (bottom - mid) / span * (f.top_m - f.bottom_m);
         let code = f.code_at(height)?;
         let range = focal_px * (f.top_m - f.bottom_m) / span;
+        // Nothing in the world is further away than `farthest_m` (ring fragments at a vignetted
+        // edge, close together, read as a pole tens of metres off).
+        if range > farthest_m {
+            return None;
+        }
+        // The rings are as wide as the pole at that range: a column of bright patches much
+        // wider than a pole so far away (a lit floor tile, a paper on a box) is not one.
+        let expected = focal_px * f.side_m / range;
+        if f64::from(width) > 2.0 * expected + 2.0 {
+            return None;
+        }
         Some([seed.centroid[0], range as f32, code as f32, top as f32, bottom as f32, 0.0])
     })
 }
@@ -86,6 +99,40 @@ mod tests {
             let z = ((x * 7919 + y * 104_729) % 251) as i32 % (2 * i32::from(n) + 1) - i32::from(n);
             (i32::from(if ring { tape } else { wall }) + z).clamp(0, 255) as u8
         })
+    }
+
+    /// Three rings `width` px wide in column 300, at rows `rows`.
+    fn column(width: u32, rows: [f32; 3]) -> Vec<Region> {
+        rows.iter()
+            .map(|&v| Region {
+                class: 1,
+                area: 2 * width,
+                bbox: [300, v as u32, 300 + width - 1, v as u32 + 1],
+                centroid: [300.0 + (width - 1) as f32 / 2.0, v],
+                mean: 220.0,
+                sd: 0.0,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_column_of_rings_too_far_or_too_wide_for_a_pole_is_none() {
+        let w = harvey_world::load_str(include_str!("../../../worlds/arena.toml"), "arena").expect("loads");
+        let f = w.poles.as_ref().expect("the arena has poles");
+        let focal = w.camera.focal_px;
+        // A pole 4 m away: top and bottom rings f (top - bottom) / 4 apart, code 3 between.
+        let span = focal * (f.top_m - f.bottom_m) / 4.0;
+        let mid = f.code_height_m(3);
+        let at = |h: f64| (240.0 - focal * (h - 1.0) / 4.0) as f32;
+        let rows = [at(f.top_m), at(mid), at(f.bottom_m)];
+        assert!((f64::from(rows[2] - rows[0]) - span).abs() < 1.0);
+        // The pole is 0.15 m wide: 21 px at 4 m.
+        let poles: Vec<_> = group(&column(21, rows), f, focal, 640, 18.0).collect();
+        assert_eq!(poles.len(), 1);
+        assert!((poles[0][1] - 4.0).abs() < 0.05 && poles[0][2] == 3.0, "{poles:?}");
+        // The same rings 60 px wide are no pole 4 m off; nor is one further than the world.
+        assert_eq!(group(&column(60, rows), f, focal, 640, 18.0).count(), 0);
+        assert_eq!(group(&column(21, rows), f, focal, 640, 3.5).count(), 0);
     }
 
     #[test]
