@@ -92,6 +92,26 @@ mod tests {
     }
 
     #[test]
+    fn the_room_has_a_stereo_rig_obstacles_of_several_heights_and_a_goal_mat() {
+        let w = load_str(include_str!("../../../worlds/room.toml"), "room.toml").expect("room loads");
+        assert_eq!(w.camera.stereo_baseline_m, Some(0.25), "003's 25 cm");
+        let mut heights: Vec<f64> = w.walls.iter().map(|x| x.height_m).filter(|h| *h < 2.6).collect();
+        heights.dedup();
+        assert_eq!(heights, [0.8, 0.9, 0.75, 1.8], "box, chair, table, cabinet");
+        // The box stands on the straight line from the start to the goal, 2.2 m ahead.
+        let hit = w.cast_ray([w.start.x_m, w.start.y_m], [1.0, 0.0], 10.0).expect("the box");
+        assert!((hit.distance_m - 2.2).abs() < 1e-9 && (w.walls[hit.wall].height_m - 0.8).abs() < 1e-9);
+        assert_eq!(w.floor_reflectance_at(7.2, 3.0), [0.92, 0.92]);
+        assert_eq!(w.floor_reflectance_at(5.0, 3.0), w.floor.reflectance);
+        // Without a rig the camera is a single one; a rig 3 m wide is refused.
+        assert_eq!(load_str(HALLWAY, "hallway.toml").expect("loads").camera.stereo_baseline_m, None);
+        let wide = include_str!("../../../worlds/room.toml")
+            .replace("stereo_baseline_m = 0.25", "stereo_baseline_m = 3.0");
+        let err = load_str(&wide, "room.toml").expect_err("too wide").to_string();
+        assert!(err.contains("camera.stereo_baseline_m"), "{err}");
+    }
+
+    #[test]
     fn the_hallway_has_locales_doors_meadows_and_landmarks() {
         let w = load_str(HALLWAY, "hallway.toml").expect("hallway loads");
         assert_eq!(w.locale_at(3.0, 0.0).map(|l| l.name.as_str()), Some("hallway"));
