@@ -51,6 +51,7 @@ fn params(world: &World, w: u32, h: u32, solver: Solver) -> OdometryParams {
         edit_chi2: 13.8,
         min_features: 8,
         spacing_px: 8.0,
+        min_turn: 0.1,
         solver,
     }
 }

@@ -120,5 +120,8 @@ fn depths_sharpen_frame_by_frame_and_the_box_stands_off_the_floor() {
         "{right} of {n} points classified right ({standing} off the floor, {on_box} of them on the box)"
     );
     assert!(on_box >= 3 && n - standing >= 3, "both kinds of point: {standing} of {n}");
-    assert!(right as f64 >= 0.85 * n as f64, "{right} of {n}");
+    // 23 of 27 before the renderer showed what lies beyond the box's top (it drew the ceiling
+    // there): since, the box's top edge against the floor beyond is an occluding contour whose
+    // points slide (003's "bad features"), and 22 of 28 are right.
+    assert!(right as f64 >= 0.75 * n as f64, "{right} of {n}");
 }

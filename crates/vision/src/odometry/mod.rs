@@ -12,10 +12,12 @@ pub mod lucas;
 pub mod reacquire;
 pub mod rig;
 pub mod rigidity;
+pub mod select;
 pub mod solve;
+mod track;
 
-use crate::image::{Gray, GrayBuf, Rect, VisionError};
-use crate::nc::{Correlator, Template};
+use crate::image::{Gray, GrayBuf, VisionError};
+use crate::nc::Correlator;
 use crate::pyramid::Pyramid;
 use crate::stereo::{Stereo, StereoParams};
 pub use lucas::LucasParams;
@@ -40,6 +42,9 @@ pub struct OdometryParams {
     pub min_features: usize,
     /// A new feature is taken only this far (pixels) from every carried one.
     pub spacing_px: f32,
+    /// A new feature is taken only where its patch's gradients turn: the structure tensor's
+    /// eigenvalues at least this far from an edge's (`select::turn_ratio`; 0 takes every one).
+    pub min_turn: f64,
     pub solver: Solver,
 }
 
@@ -227,61 +232,6 @@ impl VisualOdometry {
 
     fn no_solution(&self, carried: usize, reacquired: usize, left: usize) -> OdometryError {
         OdometryError::NoSolution { carried, reacquired, left, needed: self.params.min_features }
-    }
-
-    /// Each carried feature looked for in its predicted box and ranged: `self.pairs` and, in
-    /// the same order, `self.found` (the features as seen at this stop).
-    fn reacquire(&mut self, left: &Gray<'_>, right: &Gray<'_>, prior: &Prior) -> Result<(), OdometryError> {
-        let p = &self.params;
-        let half = p.stereo.patch / 2;
-        self.pairs.clear();
-        self.found.clear();
-        for f in &self.features {
-            let size = [left.width, left.height];
-            let Some(window) = reacquire::predicted_box(&p.rig, f.point, prior, p.box_sigmas, size, half)
-            else {
-                continue;
-            };
-            let m = self.correlator.best(left, window, &Template::new(&f.patch)?)?;
-            if m.score < p.track_min_score {
-                continue;
-            }
-            let (x, y) = (m.x + half, m.y + half);
-            let Some(s) = self.stereo.match_at(left, right, x, y, &p.stereo)? else { continue };
-            let Some(point) = p.rig.triangulate(m.centre, s.disparity) else { continue };
-            self.pairs.push(Pair {
-                old: f.point,
-                new: point,
-                old_cov: p.rig.covariance(f.point),
-                new_cov: p.rig.covariance(point),
-            });
-            let patch = GrayBuf::crop(left, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?;
-            self.found.push(Feature { point, at: m.centre, patch });
-        }
-        Ok(())
-    }
-
-    /// New features ranged in the left image, away from those carried, up to the interest
-    /// operator's count in all.
-    fn top_up(&mut self, left: &Gray<'_>, right: &Gray<'_>) -> Result<(), OdometryError> {
-        let p = &self.params;
-        let half = p.stereo.patch / 2;
-        let spacing = p.spacing_px * p.spacing_px;
-        let matches = self.stereo.match_points(left, right, left.full(), &p.stereo)?;
-        for m in matches {
-            if self.features.len() >= p.stereo.moravec.max_corners {
-                break;
-            }
-            let near = |f: &Feature| (f.at[0] - m.left[0]).powi(2) + (f.at[1] - m.left[1]).powi(2) < spacing;
-            if self.features.iter().any(near) {
-                continue;
-            }
-            let Some(point) = p.rig.triangulate(m.left, m.disparity) else { continue };
-            let (x, y) = (m.left[0] as usize, m.left[1] as usize);
-            let patch = GrayBuf::crop(left, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?;
-            self.features.push(Feature { point, at: m.left, patch });
-        }
-        Ok(())
     }
 }
 

@@ -9,13 +9,18 @@ pub fn seen(w: &World, size: [u32; 2], pose: Pose2, at: [f32; 2]) -> (f64, f64) 
     let left = (f64::from(size[0]) / 2.0 - f64::from(at[0])) / f;
     let down = (f64::from(at[1]) - f64::from(size[1]) / 2.0) / f;
     let a = pose.heading_rad + left.atan();
-    let floor = if down > 0.0 { w.camera.height_m / down } else { f64::INFINITY };
-    match w.cast_ray([pose.x_m, pose.y_m], [a.cos(), a.sin()], 1e3) {
-        Some(hit) => {
-            let depth = hit.distance_m * left.atan().cos();
-            let z = w.camera.height_m - down * depth;
-            if z >= 0.0 { (depth, z) } else { (floor, 0.0) }
-        }
+    let h = w.camera.height_m;
+    let floor = if down > 0.0 { h / down } else { f64::INFINITY };
+    // The nearest wall the ray meets between the floor and the wall's top (it passes over a
+    // lower one), as the renderer draws it; else the floor.
+    let wall = w
+        .ray_hits([pose.x_m, pose.y_m], [a.cos(), a.sin()], 1e3)
+        .map(|hit| (hit.distance_m * left.atan().cos(), w.walls[hit.wall].height_m))
+        .filter(|&(depth, top)| (0.0..=top).contains(&(h - down * depth)))
+        .map(|(depth, _)| depth)
+        .min_by(f64::total_cmp);
+    match wall {
+        Some(depth) => (depth, h - down * depth),
         None => (floor, 0.0),
     }
 }
