@@ -13,6 +13,8 @@
 
 mod geometry;
 mod odometry;
+#[path = "../tests/common/odometry_params.rs"]
+mod odometry_params;
 mod paths;
 mod reference;
 mod reference_geometry;

@@ -7,13 +7,9 @@
 
 use std::hint::black_box;
 
-use harvey_vision::moravec::MoravecParams;
 use harvey_vision::odometry::reacquire::predicted_box;
 use harvey_vision::odometry::solve::{Pair, solve};
-use harvey_vision::odometry::{
-    LucasParams, Motion, OdometryParams, Prior, Rig, Solver, Tolerance, VisualOdometry,
-};
-use harvey_vision::stereo::StereoParams;
+use harvey_vision::odometry::{LucasParams, Motion, OdometryParams, Prior, Solver, VisualOdometry};
 use harvey_vision::{Gray, GrayBuf, Rect};
 use harvey_world::{Pose2, World};
 
@@ -24,36 +20,7 @@ use crate::{Row, frame_at, measure};
 const BASELINE_M: f64 = 0.25;
 
 fn params(world: &World, w: u32, h: u32, solver: Solver) -> OdometryParams {
-    let rig = Rig {
-        focal_px: world.camera.focal_for(w),
-        centre_px: [f64::from(w) / 2.0, f64::from(h) / 2.0],
-        baseline_m: BASELINE_M,
-        height_m: world.camera.height_m,
-        disparity_sd_px: 0.3,
-        position_sd_px: 0.3,
-    };
-    OdometryParams {
-        rig,
-        stereo: StereoParams {
-            focal_px: rig.focal_px as f32,
-            baseline_m: BASELINE_M as f32,
-            band_rows: 2,
-            near_m: 1.5,
-            far_m: 1000.0,
-            patch: 11,
-            min_score: 0.9,
-            min_margin: 0.0,
-            moravec: MoravecParams { window: 5, threshold: 3000, suppress_radius: 6, max_corners: 150 },
-        },
-        track_min_score: 0.8,
-        box_sigmas: 3.0,
-        rigidity: Tolerance { sigmas: 4.0, floor_m: 0.03 },
-        edit_chi2: 13.8,
-        min_features: 8,
-        spacing_px: 8.0,
-        min_turn: 0.1,
-        solver,
-    }
+    crate::odometry_params::params(world, w, h, BASELINE_M, solver)
 }
 
 pub fn bench_odometry(world: &World, rows: &mut Vec<Row>) {

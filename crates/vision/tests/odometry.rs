@@ -36,19 +36,7 @@ fn stop_to_stop_motion_holds_over_seeds_and_conditions() {
     for condition in ["nominal", "dim", "harsh"] {
         for seed in 1..=8 {
             let f = run(&world("hallway", condition), &course(seed, 21), seed, Solver::MatchThenSolve);
-            println!(
-                "{condition:8} seed {seed}: {} steps over {:.2} m, {} unsolved, worst step {:.3} m {:.2} deg \
-                 (predicted {:.3} m {:.2} deg), fewest features {}, position model {:.3} m off at the end",
-                f.steps,
-                f.travelled_m,
-                f.failed,
-                f.worst_step_m,
-                f.worst_heading_rad.to_degrees(),
-                f.worst_predicted_m,
-                f.worst_predicted_rad.to_degrees(),
-                f.fewest_used,
-                f.final_error_m
-            );
+            println!("{condition:8} seed {seed}: {f}");
             assert!(f.travelled_m >= 6.0, "a course of {:.2} m", f.travelled_m);
             assert_eq!(f.failed, 0, "{condition} seed {seed}: every step solved");
             // The prediction is off by up to 3.6 degrees; the solution never by half a degree.

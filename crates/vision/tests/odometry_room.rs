@@ -50,19 +50,7 @@ fn the_room_course_by_both_solvers() {
             assert!(goal.distance(&Pose2::new(7.2, 3.0, 0.0)) < 0.1, "the course ends on the mat");
             for (name, solver) in [("match then solve", Solver::MatchThenSolve), ("Lucas", LUCAS)] {
                 let f = run(&w, &poses, seed, solver);
-                println!(
-                    "{condition:8} seed {seed} {name:16}: {} steps over {:.2} m, {} unsolved, worst step {:.3} m \
-                     {:.2} deg (predicted {:.3} m {:.2} deg), fewest features {}, end {:.3} m",
-                    f.steps,
-                    f.travelled_m,
-                    f.failed,
-                    f.worst_step_m,
-                    f.worst_heading_rad.to_degrees(),
-                    f.worst_predicted_m,
-                    f.worst_predicted_rad.to_degrees(),
-                    f.fewest_used,
-                    f.final_error_m
-                );
+                println!("{condition:8} seed {seed} {name:16}: {f}");
                 rows.push((condition, seed, name, f));
             }
         }

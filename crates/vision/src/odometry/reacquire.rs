@@ -58,14 +58,7 @@ mod tests {
     use super::*;
 
     fn rig() -> Rig {
-        Rig {
-            focal_px: 554.0,
-            centre_px: [320.0, 240.0],
-            baseline_m: 0.25,
-            height_m: 1.2,
-            disparity_sd_px: 0.3,
-            position_sd_px: 0.3,
-        }
+        super::super::rig::example()
     }
 
     #[test]

@@ -110,14 +110,7 @@ mod tests {
 
     #[test]
     fn a_feature_that_moved_against_the_others_is_dropped() {
-        let rig = Rig {
-            focal_px: 554.0,
-            centre_px: [320.0, 240.0],
-            baseline_m: 0.25,
-            height_m: 1.2,
-            disparity_sd_px: 0.3,
-            position_sd_px: 0.3,
-        };
+        let rig = super::super::rig::example();
         // The robot moved 0.5 m forward: every point is 0.5 m nearer, except one false match.
         let mut pairs: Vec<Pair> = (0..12)
             .map(|i| {

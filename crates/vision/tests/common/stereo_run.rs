@@ -7,12 +7,11 @@ use harvey_geometry::Rng;
 use harvey_msgs::Encoding;
 use harvey_render::{Effects, Renderer, mount_error};
 use harvey_vision::Gray;
-use harvey_vision::moravec::MoravecParams;
-use harvey_vision::odometry::{
-    Motion, OdometryError, OdometryParams, Prior, Rig, Solver, Tolerance, VisualOdometry,
-};
-use harvey_vision::stereo::StereoParams;
+use harvey_vision::odometry::{Motion, OdometryError, OdometryParams, Prior, Solver, VisualOdometry};
 use harvey_world::{Pose2, World};
+
+#[path = "odometry_params.rs"]
+mod odometry_params;
 
 pub const W: u32 = 640;
 pub const H: u32 = 480;
@@ -67,45 +66,9 @@ impl StereoCamera {
     }
 }
 
-/// The odometry's settings: 003's constraints where the paper gives them.
+/// The odometry's settings for this camera and rig.
 pub fn params(w: &World) -> OdometryParams {
-    let rig = Rig {
-        focal_px: w.camera.focal_for(W),
-        centre_px: [f64::from(W) / 2.0, f64::from(H) / 2.0],
-        baseline_m: baseline(w),
-        height_m: w.camera.height_m,
-        disparity_sd_px: 0.3,
-        position_sd_px: 0.3,
-    };
-    OdometryParams {
-        rig,
-        stereo: StereoParams {
-            focal_px: rig.focal_px as f32,
-            baseline_m: baseline(w) as f32,
-            // 003 searched a band of 5-10 % of the image height for its uncalibrated cameras; this
-            // rig is calibrated to 3 mrad (the world's `[survey]`), under 2 px at this focal
-            // length. The paper's band (12 rows each way) let points on edges slide along them:
-            // on the harsh day its median disparity error was 5 px, with this band 2 px.
-            // Near limit 1.5 m and far limit "infinity" (far beyond any wall here), as 003's.
-            band_rows: 2,
-            near_m: 1.5,
-            far_m: 1000.0,
-            patch: 11,
-            min_score: 0.9,
-            min_margin: 0.0,
-            moravec: MoravecParams { window: 5, threshold: 3000, suppress_radius: 6, max_corners: 150 },
-        },
-        track_min_score: 0.8,
-        box_sigmas: 3.0,
-        rigidity: Tolerance { sigmas: 4.0, floor_m: 0.03 },
-        edit_chi2: 13.8,
-        min_features: 8,
-        spacing_px: 8.0,
-        // An edge's patch has a ratio near 0 (a corner's near 1): a tenth keeps corners of two
-        // edges of quite different contrast and leaves edges in any direction out.
-        min_turn: 0.1,
-        solver: Solver::MatchThenSolve,
-    }
+    odometry_params::params(w, W, H, baseline(w), Solver::MatchThenSolve)
 }
 
 pub fn gray(px: &[u8]) -> Gray<'_> {
@@ -127,6 +90,25 @@ pub struct Figures {
     pub fewest_used: usize,
     pub final_error_m: f64,
     pub travelled_m: f64,
+}
+
+impl std::fmt::Display for Figures {
+    fn fmt(&self, out: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            out,
+            "{} steps over {:.2} m, {} unsolved, worst step {:.3} m {:.2} deg (predicted {:.3} m {:.2} deg), \
+             fewest features {}, position model {:.3} m off at the end",
+            self.steps,
+            self.travelled_m,
+            self.failed,
+            self.worst_step_m,
+            self.worst_heading_rad.to_degrees(),
+            self.worst_predicted_m,
+            self.worst_predicted_rad.to_degrees(),
+            self.fewest_used,
+            self.final_error_m
+        )
+    }
 }
 
 /// Runs the odometry over the course `poses` in `w`: each step's prediction is the true motion
