@@ -169,7 +169,9 @@ impl VisualOdometry {
                 }
             },
         };
-        // After a registration the features are looked for where its motion puts them.
+        // After a registration the features are looked for where its motion puts them, in a
+        // box of its own uncertainty but never under 1 cm and 0.3 degree a side per sd (a
+        // registration's covariance takes no account of the depths' own errors).
         let near = registered.as_ref().map(|r| Prior {
             motion: r.motion,
             sd: std::array::from_fn(|k| r.covariance[k][k].sqrt().max([0.01, 0.01, 0.005][k])),
