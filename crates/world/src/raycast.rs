@@ -69,4 +69,19 @@ mod tests {
         assert!((hit.incidence_rad - 60f64.to_radians()).abs() < 1e-9);
         assert!(w.cast_ray([2.0, 0.0], [0.0, 1.0], 0.5).is_none(), "beyond max range");
     }
+
+    #[test]
+    fn every_wall_on_the_ray_comes_nearest_first() {
+        let w = load_str(include_str!("../../../worlds/room.toml"), "room").expect("loads");
+        // From the start towards the goal: the box's near and far faces, then the east wall.
+        let mut hits = Vec::new();
+        w.cast_ray_all([w.start.x_m, w.start.y_m], [1.0, 0.0], 100.0, &mut hits);
+        let at: Vec<(f64, f64)> = hits.iter().map(|h| (h.distance_m, w.walls[h.wall].height_m)).collect();
+        let expect = [(2.2, 0.8), (2.8, 0.8), (7.2, 2.6)];
+        assert_eq!(at.len(), expect.len(), "{at:?}");
+        for ((d, h), (ed, eh)) in at.iter().zip(expect) {
+            assert!((d - ed).abs() < 1e-9 && (h - eh).abs() < 1e-9, "{at:?}");
+        }
+        assert_eq!(w.cast_ray([w.start.x_m, w.start.y_m], [1.0, 0.0], 100.0), Some(hits[0]));
+    }
 }
