@@ -170,7 +170,7 @@ fn assert_clean(kind: &str, t: &Tally, took: Duration) {
 #[test]
 fn mutated_worlds_never_panic_and_refuse_every_impossible_number_by_name() {
     let files = shipped("worlds");
-    assert_eq!(files.len(), 4, "the shipped worlds");
+    assert_eq!(files.len(), 5, "the shipped worlds");
     let started = Instant::now();
     let t = run(
         &files,

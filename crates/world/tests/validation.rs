@@ -107,7 +107,7 @@ fn every_shipped_world_loads() {
             n += 1;
         }
     }
-    assert_eq!(n, 4);
+    assert_eq!(n, 5);
 }
 
 #[test]

@@ -65,7 +65,7 @@ fn the_shipped_conditions_apply_to_every_shipped_world() {
     for name in ["nominal", "dim", "harsh"] {
         let file = Path::new(env!("CARGO_MANIFEST_DIR")).join("conditions").join(format!("{name}.toml"));
         let c = Condition::load(&file).expect("loads");
-        for world in ["hallway", "dock", "arena", "campus"] {
+        for world in ["hallway", "dock", "arena", "campus", "room"] {
             let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("worlds").join(format!("{world}.toml"));
             let text = std::fs::read_to_string(&path).expect("world");
             c.apply(&text, world).unwrap_or_else(|e| panic!("{name} on {world}: {e}"));
