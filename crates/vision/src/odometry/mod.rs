@@ -17,7 +17,7 @@ pub mod solve;
 mod track;
 
 use crate::image::{Gray, GrayBuf, VisionError};
-use crate::nc::Correlator;
+use crate::nc::{Correlator, Template};
 use crate::pyramid::Pyramid;
 use crate::stereo::{Stereo, StereoParams};
 pub use lucas::LucasParams;
@@ -102,6 +102,8 @@ pub struct VisualOdometry {
     params: OdometryParams,
     stereo: Stereo,
     correlator: Correlator,
+    /// The reacquisition's template, its buffers reused from feature to feature.
+    template: Option<Template>,
     features: Vec<Feature>,
     size: Option<[usize; 2]>,
     pairs: Vec<Pair>,
@@ -117,6 +119,7 @@ impl VisualOdometry {
             params,
             stereo: Stereo::default(),
             correlator: Correlator::default(),
+            template: None,
             features: Vec::new(),
             size: None,
             pairs: Vec::new(),

@@ -25,7 +25,12 @@ impl VisualOdometry {
             else {
                 continue;
             };
-            let m = self.correlator.best(left, window, &Template::new(&f.patch)?)?;
+            match &mut self.template {
+                Some(t) => t.set(&f.patch)?,
+                None => self.template = Some(Template::new(&f.patch)?),
+            }
+            let Some(template) = &self.template else { continue };
+            let m = self.correlator.best(left, window, template)?;
             if m.score < p.track_min_score {
                 continue;
             }
@@ -38,8 +43,7 @@ impl VisualOdometry {
                 old_cov: p.rig.covariance(f.point),
                 new_cov: p.rig.covariance(point),
             });
-            let patch = GrayBuf::crop(left, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?;
-            self.found.push(Feature { point, at: m.centre, patch });
+            self.found.push(Feature { point, at: m.centre, patch: patch_at(left, x, y, half)? });
         }
         Ok(())
     }
@@ -67,9 +71,13 @@ impl VisualOdometry {
                 continue;
             }
             let Some(point) = p.rig.triangulate(m.left, m.disparity) else { continue };
-            let patch = GrayBuf::crop(left, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?;
-            self.features.push(Feature { point, at: m.left, patch });
+            self.features.push(Feature { point, at: m.left, patch: patch_at(left, x, y, half)? });
         }
         Ok(())
     }
+}
+
+/// The `(2 half + 1)²` patch of `img` centred on pixel `(x, y)`.
+fn patch_at(img: &Gray<'_>, x: usize, y: usize, half: usize) -> Result<GrayBuf, OdometryError> {
+    Ok(GrayBuf::crop(img, Rect::new(x - half, y - half, x + half + 1, y + half + 1))?)
 }
