@@ -1,6 +1,7 @@
 //! Zero copy, proven across processes: the camera process renders into a loaned shared-memory
 //! slice; this process receives the frame, finds its pixels inside a /dev/shm mapping of its own
-//! address space, and checks them against a local render of the same view.
+//! address space, and checks them against a local render of the same view (both views of a
+//! stereo pair).
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
@@ -26,10 +27,11 @@ fn shm_mappings() -> Vec<(usize, usize, String)> {
         .collect()
 }
 
-fn check(width: u32, height: u32, encoding: Encoding) {
+fn check(width: u32, height: u32, encoding: Encoding, stereo: bool) {
     let prefix = common::unique_prefix("zc");
-    let world_path = common::repo().join("worlds/hallway.toml");
-    let pose = [5.0, 0.1, 3.0f64];
+    let world_name = if stereo { "worlds/room.toml" } else { "worlds/hallway.toml" };
+    let world_path = common::repo().join(world_name);
+    let pose = if stereo { [1.0, 3.0, 2.0] } else { [5.0, 0.1, 3.0f64] };
     let mut camera = Command::new(common::bin("harvey-camera"))
         .args([
             "--world",
@@ -47,6 +49,7 @@ fn check(width: u32, height: u32, encoding: Encoding) {
             "--pose",
             &format!("{},{},{}", pose[0], pose[1], pose[2]),
         ])
+        .args(stereo.then_some("--stereo"))
         .env(harvey_bus::PREFIX_ENV, &prefix)
         .stdout(Stdio::null())
         .spawn()
@@ -69,8 +72,10 @@ fn check(width: u32, height: u32, encoding: Encoding) {
 
     let h = *frame.header();
     assert_eq!((h.width_px, h.height_px, h.encoding()), (width, height, Some(encoding)));
+    let views = if stereo { 2 } else { 1 };
+    assert_eq!(h.views(), views);
     let pixels = frame.pixels();
-    assert_eq!(pixels.len(), (width * height * encoding.bytes_per_pixel()) as usize);
+    assert_eq!(pixels.len(), (views * width * height * encoding.bytes_per_pixel()) as usize);
     let (start, end) = (pixels.as_ptr() as usize, pixels.as_ptr() as usize + pixels.len());
     let maps = shm_mappings();
     let inside = maps.iter().find(|(a, b, _)| *a <= start && end <= *b);
@@ -81,20 +86,23 @@ fn check(width: u32, height: u32, encoding: Encoding) {
     // What the camera renders (its default seed, 1): the world as built, through its misaligned
     // mount, with the world's imaging effects for this frame.
     let world = harvey_world::World::load(&world_path).expect("world").as_built(1);
+    // A stereo pair is two renders from either side of the mount (the left one first), each
+    // with the effects (the right one's noise drawn as another frame).
     let (yaw, pitch) = harvey_render::mount_error(&world.camera, 1);
     let mut renderer = Renderer::new(&world, width, height, encoding).misaligned(yaw, pitch);
-    let mut expected = vec![0u8; renderer.frame_bytes()];
+    let n = renderer.frame_bytes();
+    let mut expected = vec![0u8; n * views as usize];
     let from = harvey_world::Pose2::from_degrees(pose[0], pose[1], pose[2]);
-    renderer.render(&world, from, &mut expected).expect("render");
     let bpp = encoding.bytes_per_pixel() as usize;
-    harvey_render::Effects::from_camera(&world.camera, 1).apply_at(
-        width as usize,
-        height as usize,
-        bpp,
-        h.seq,
-        h.stamp_ns,
-        &mut expected,
-    );
+    let sides: &[(f64, u64)] = match world.camera.stereo_baseline_m.filter(|_| stereo) {
+        Some(b) => &[(b / 2.0, h.seq), (-b / 2.0, h.seq ^ (1 << 63))],
+        None => &[(0.0, h.seq)],
+    };
+    for (view, (side, noise_seq)) in expected.chunks_exact_mut(n).zip(sides) {
+        renderer.render(&world, from.sideways(*side), view).expect("render");
+        let effects = harvey_render::Effects::from_camera(&world.camera, 1);
+        effects.apply_at(width as usize, height as usize, bpp, *noise_seq, h.stamp_ns, view);
+    }
     assert_eq!(checksum(pixels), checksum(&expected), "frame content differs from the render");
 
     drop(frame);
@@ -110,10 +118,15 @@ fn check(width: u32, height: u32, encoding: Encoding) {
 
 #[test]
 fn vga_mono8_frames_are_read_in_place() {
-    check(640, 480, Encoding::Mono8);
+    check(640, 480, Encoding::Mono8, false);
+}
+
+#[test]
+fn stereo_pairs_are_read_in_place() {
+    check(640, 480, Encoding::Mono8, true);
 }
 
 #[test]
 fn full_hd_rgb8_frames_are_read_in_place() {
-    check(1920, 1080, Encoding::Rgb8);
+    check(1920, 1080, Encoding::Rgb8, false);
 }

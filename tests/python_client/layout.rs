@@ -154,7 +154,7 @@ fn rust_layouts() -> Vec<Value> {
             items
         }),
         layout!(LogLine { header, level, name_len, text_len, name, text }),
-        layout!(FrameHeader { seq, stamp_ns, width_px, height_px, stride_bytes, encoding }),
+        layout!(FrameHeader { seq, stamp_ns, width_px, height_px, stride_bytes, encoding, views, reserved }),
     ]
 }
 

@@ -21,5 +21,9 @@ pub const ODOM: &str = "odom";
 pub const BASE_LINK: &str = "base_link";
 /// The camera's optical frame: images, features, windows and sightings are in it.
 pub const CAMERA: &str = "camera";
+/// A stereo pair's image (003): the left camera's image (its optical frame is [`CAMERA`]) with
+/// the right one stacked under it, twice the camera's height. Only the frame id tells a
+/// recorded pair from one tall image, so it is how the pair is read back.
+pub const STEREO_PAIR: &str = "camera_stereo_pair";
 /// The simulator's true robot pose.
 pub const TRUTH: &str = "truth";

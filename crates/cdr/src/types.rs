@@ -62,11 +62,13 @@ impl Cdr for Header {
     }
 }
 
-/// Encodes a camera frame as `sensor_msgs/msg/Image` into `buf` (reused).
+/// Encodes a camera frame as `sensor_msgs/msg/Image` into `buf` (reused). A stereo pair is one
+/// image of its views stacked (left on top), named by its frame id ([`frames::STEREO_PAIR`]).
 pub fn encode_image(h: &FrameHeader, pixels: &[u8], buf: Vec<u8>) -> Vec<u8> {
     let mut w = CdrWriter::start(buf);
-    write_std_header(h.stamp_ns, frames::CAMERA, &mut w);
-    w.prim(h.height_px);
+    let stereo = h.views() == 2;
+    write_std_header(h.stamp_ns, if stereo { frames::STEREO_PAIR } else { frames::CAMERA }, &mut w);
+    w.prim(h.height_px * h.views());
     w.prim(h.width_px);
     w.string(h.encoding().map_or("", |e| e.ros_name()));
     w.prim(0u8);
@@ -81,8 +83,17 @@ pub fn decode_image(data: &[u8]) -> Result<(FrameHeader, &[u8]), CdrError> {
     let mut r = CdrReader::new(data)?;
     let sec = r.prim::<i32>()?;
     let nanosec = r.prim::<u32>()?;
-    let _frame_id = r.string()?;
-    let height_px = r.prim::<u32>()?;
+    let frame_id = r.string()?;
+    let at = data.len() - r.remaining();
+    let rows = r.prim::<u32>()?;
+    let views = if frame_id == frames::STEREO_PAIR { 2 } else { 1 };
+    if rows % views != 0 {
+        return Err(CdrError::Invalid {
+            at,
+            what: format!("a stereo pair of {rows} rows (not two equal images)"),
+        });
+    }
+    let height_px = rows / views;
     let width_px = r.prim::<u32>()?;
     let at = data.len() - r.remaining();
     let encoding = r.string()?;
@@ -92,11 +103,20 @@ pub fn decode_image(data: &[u8]) -> Result<(FrameHeader, &[u8]), CdrError> {
     let stride_bytes = r.prim::<u32>()?;
     let pixels = r.byte_seq()?;
     let stamp_ns = u64::try_from(sec).unwrap_or(0) * 1_000_000_000 + u64::from(nanosec);
-    let h = FrameHeader { seq: 0, stamp_ns, width_px, height_px, stride_bytes, encoding: enc as u32 };
+    let h = FrameHeader {
+        seq: 0,
+        stamp_ns,
+        width_px,
+        height_px,
+        stride_bytes,
+        encoding: enc as u32,
+        views,
+        reserved: 0,
+    };
     if pixels.len() != h.payload_len() {
         return Err(CdrError::Invalid {
             at,
-            what: format!("{} pixel bytes for a {width_px}x{height_px} {encoding} image", pixels.len()),
+            what: format!("{} pixel bytes for a {width_px}x{rows} {encoding} image", pixels.len()),
         });
     }
     Ok((h, pixels))
@@ -311,5 +331,29 @@ mod tests {
             (1_000_000_005, 2, 2, &[1u8, 2, 3, 4][..])
         );
         assert!(decode_image(&bytes[..bytes.len() - 1]).is_err());
+    }
+
+    #[test]
+    fn a_stereo_pair_is_one_stacked_image_read_back_as_a_pair() {
+        let h = FrameHeader::stereo(3, 7, 2, 1, Encoding::Mono8);
+        let bytes = encode_image(&h, &[1, 2, 3, 4], Vec::new());
+        let mut r = CdrReader::new(&bytes).expect("header");
+        let _stamp = (r.prim::<i32>().expect("sec"), r.prim::<u32>().expect("ns"));
+        assert_eq!(r.string().expect("frame_id"), frames::STEREO_PAIR);
+        assert_eq!((r.prim::<u32>().expect("h"), r.prim::<u32>().expect("w")), (2, 1 + 1));
+        let (back, px) = decode_image(&bytes).expect("decodes");
+        assert_eq!((back.views(), back.height_px, px), (2, 1, &[1u8, 2, 3, 4][..]));
+        // A pair of an odd number of rows is not two images.
+        let mut w = CdrWriter::start(Vec::new());
+        write_std_header(7, frames::STEREO_PAIR, &mut w);
+        w.prim(3u32);
+        w.prim(2u32);
+        w.string("mono8");
+        w.prim(0u8);
+        w.prim(2u32);
+        w.byte_seq(&[0; 6]);
+        let relabelled = w.finish();
+        let e = decode_image(&relabelled).expect_err("three rows for a pair");
+        assert!(e.to_string().contains("stereo pair of 3 rows"), "{e}");
     }
 }

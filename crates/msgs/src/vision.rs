@@ -54,12 +54,25 @@ pub enum VisionAlgorithm {
     /// the middle ring's height between them the code. Items, nearest first: `[u, range_m, code,
     /// v_top, v_bottom, 0]`. A world without `[poles]` is a bad parameter.
     Poles = 8,
+    /// Stereo visual odometry stop to stop (003), on a stereo frame ([`crate::FrameHeader::views`]
+    /// 2), best as a standing request whose id keeps its features: `expected` is the motion
+    /// predicted since the last answered frame (x, y in metres, heading in radians, in that stop's
+    /// robot frame). params: start afresh at this frame (1) or not (0; the first frame of an id
+    /// starts), solver (0 match-then-solve, 1 Lucas registration), the prediction's standard
+    /// deviations x, y (m), heading (rad) (zeros: the worker's `--odometry` settings). The
+    /// window is not used. Items: `[dx, dy, dheading, sd_x, sd_y, sd_heading]` the motion
+    /// (zeros unless solved), `[features, used, carried, reacquired, pruned, error_scale]`,
+    /// then obstacle points `[x, y, z, range_sd, u, v]` in this stop's robot frame, nearest
+    /// first. `NotFound`: no motion solution (too few features held; the next frame is solved
+    /// against this one). A mono frame is a bad frame; a world without a stereo baseline or a
+    /// worker without settings, a bad parameter.
+    StereoOdometry = 9,
 }
 
 impl VisionAlgorithm {
     pub fn from_raw(raw: u32) -> Option<Self> {
         use VisionAlgorithm::*;
-        [Correlate, Moravec, LineFinder, RegionSegmenter, Phototropic, Activity, Dock, Poles]
+        [Correlate, Moravec, LineFinder, RegionSegmenter, Phototropic, Activity, Dock, Poles, StereoOdometry]
             .into_iter()
             .find(|a| *a as u32 == raw)
     }

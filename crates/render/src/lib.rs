@@ -1,13 +1,15 @@
 //! The camera's renderer: ray casting the world's walls and floor from a pose through a pinhole
 //! camera, pixel = illumination x reflectance, written straight into the caller's buffer (the
-//! loaned shared-memory slice).
+//! loaned shared-memory slice); `Shooter` a whole frame, one camera's or a stereo pair's.
 
 mod blur;
 mod effects;
+mod shot;
 
 pub use effects::{Effects, mount_error};
 use harvey_msgs::Encoding;
 use harvey_world::{Pose2, World};
+pub use shot::Shooter;
 
 /// Why a frame could not be rendered.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

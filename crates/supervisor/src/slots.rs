@@ -57,8 +57,8 @@ pub fn find_binary(name: &str) -> Option<PathBuf> {
     beside.into_iter().chain(on_path).find(|p| p.is_file())
 }
 
-/// The values a launch file's `${...}` stand for: the run folder, seed, launch file, bus prefix
-/// and world (which must exist).
+/// The values a launch file's `${...}` stand for: the run folder, seed, launch file and its
+/// folder (where the data files it names are), bus prefix and world (which must exist).
 pub fn variables(
     launch: &LaunchFile,
     run_dir: &Path,
@@ -68,6 +68,10 @@ pub fn variables(
         ("run_dir", absolute(run_dir).display().to_string()),
         ("seed", launch.settings.seed.to_string()),
         ("mission", absolute(&launch.path).display().to_string()),
+        (
+            "mission_dir",
+            absolute(&launch.path).parent().map_or_else(String::new, |d| d.display().to_string()),
+        ),
         ("prefix", prefix.to_owned()),
     ];
     if let Some(w) = launch.world_path() {
@@ -155,6 +159,8 @@ mod tests {
         assert_eq!(substitute("--seed=${seed}", &vars), "--seed=7");
         assert_eq!(substitute("${run_dir}/drv.pty ${run_dir}", &vars), "/r/drv.pty /r");
         assert_eq!(substitute("${unknown} $seed", &vars), "${unknown} $seed");
+        let vars = [("mission", "/m/a.toml".to_owned()), ("mission_dir", "/m".to_owned())];
+        assert_eq!(substitute("${mission} ${mission_dir}/b.toml", &vars), "/m/a.toml /m/b.toml");
     }
 
     #[test]

@@ -43,7 +43,7 @@ DISCOVERY_PERIOD_S = 0.1
 @dataclass
 class Frame:
     """A camera frame, copied out of shared memory: `pixels` is `(height, width)` for mono8,
-    `(height, width, 3)` for rgb8."""
+    `(height, width, 3)` for rgb8; a stereo pair's has the views first, `(2, height, width)`."""
 
     header: msgs.FrameHeader
     pixels: np.ndarray
@@ -272,14 +272,16 @@ def _frame(sample: Any) -> Frame:
     n = payload.len()
     raw = np.frombuffer((ctypes.c_uint8 * n).from_address(payload.as_ptr()), dtype=np.uint8).copy()
     bpp = msgs.BYTES_PER_PIXEL.get(header.encoding)
-    h, w, stride = header.height_px, header.width_px, header.stride_bytes
-    if bpp is None or stride < w * bpp or n != stride * h:
+    h, w, stride, views = header.height_px, header.width_px, header.stride_bytes, header.view_count()
+    if bpp is None or stride < w * bpp or n != stride * h * views:
         raise HarveyError(
-            f"frame {header.seq}: {n} bytes do not hold {w}x{h} of encoding {header.encoding} "
-            f"in rows of {stride} bytes"
+            f"frame {header.seq}: {n} bytes do not hold {views} view(s) of {w}x{h} of encoding "
+            f"{header.encoding} in rows of {stride} bytes"
         )
-    rows = raw.reshape(h, stride)[:, : w * bpp]
+    rows = raw.reshape(h * views, stride)[:, : w * bpp]
     shape = (h, w) if bpp == 1 else (h, w, bpp)
+    if views > 1:
+        shape = (views, *shape)
     return Frame(header=header, pixels=np.ascontiguousarray(rows).reshape(shape))
 
 

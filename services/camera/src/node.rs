@@ -1,5 +1,6 @@
 //! The camera as a node (`harvey_runtime::Node`): its arguments, its source (the simulator's
-//! true pose, a fixed pose at a rate, or a folder of images at a rate) and its turn.
+//! true pose, a fixed pose at a rate, or a folder of images at a rate) and its turn; with
+//! `--stereo`, each frame a stereo pair (003's two cameras).
 
 use std::path::PathBuf;
 use std::time::Duration;
@@ -7,7 +8,7 @@ use std::time::Duration;
 use anyhow::Context;
 use clap::Parser;
 use harvey_msgs::{Encoding, FrameHeader, TruePose, topics};
-use harvey_render::{Effects, Renderer, checksum, mount_error};
+use harvey_render::{Effects, Renderer, Shooter, checksum, mount_error};
 use harvey_runtime::{End, FrameOut, In, Io, Node, Ports};
 use harvey_world::{Pose2, World};
 
@@ -49,13 +50,16 @@ pub struct Args {
     /// A launch file whose `[[mover]]` tables put moving things in the world.
     #[arg(long)]
     movers: Option<PathBuf>,
+    /// A stereo pair (003) in each frame, the left image then the right, taken at one instant
+    /// by two cameras the world's `[camera] stereo_baseline_m` apart, centred on the mount.
+    #[arg(long, conflicts_with = "images")]
+    stereo: bool,
 }
 
 /// The rendered world.
 struct Scene {
     world: World,
-    renderer: Renderer,
-    effects: Effects,
+    shooter: Shooter,
 }
 
 impl Scene {
@@ -70,16 +74,9 @@ impl Scene {
     ) -> anyhow::Result<()> {
         // Moving things where they are at the frame's simulated time.
         self.world.set_time(stamp_ns as f64 * 1e-9);
-        let r = &self.renderer;
-        let header = FrameHeader::new(seq, stamp_ns, r.width_px(), r.height_px(), r.encoding());
-        let (w, h, bpp) = (
-            header.width_px as usize,
-            header.height_px as usize,
-            header.stride_bytes as usize / header.width_px as usize,
-        );
+        let header = self.shooter.header(seq, stamp_ns);
         io.send_frame(out, header, |pixels| {
-            self.renderer.render(&self.world, pose, pixels)?;
-            self.effects.apply_at(w, h, bpp, seq, stamp_ns, pixels);
+            self.shooter.take(&self.world, pose, seq, stamp_ns, pixels)?;
             tracing::debug!(seq, checksum = checksum(pixels), "frame");
             Ok(())
         })?;
@@ -196,8 +193,17 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<Camera> {
     }
     let renderer = Renderer::new(&world, width, height, encoding).misaligned(yaw, pitch);
     let effects = Effects::from_camera(&world.camera, args.seed);
-    let out = p.frames_out(topics::CAMERA_FRAME, renderer.frame_bytes());
-    let scene = Scene { world, renderer, effects };
+    let baseline_m = match (args.stereo, world.camera.stereo_baseline_m) {
+        (false, _) => None,
+        (true, Some(b)) => Some(b),
+        (true, None) => anyhow::bail!(
+            "--stereo: the world {} has no `[camera] stereo_baseline_m` (the distance between the pair's cameras)",
+            world_path.display()
+        ),
+    };
+    let shooter = Shooter { renderer, effects, baseline_m };
+    let out = p.frames_out(topics::CAMERA_FRAME, shooter.frame_bytes());
+    let scene = Scene { world, shooter };
     let source = match &args.pose {
         Some(v) => {
             anyhow::ensure!(v.len() == 3, "--pose takes x_m,y_m,heading_deg; got {} values", v.len());

@@ -17,6 +17,8 @@ use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect, VisionError};
 use harvey_world::World;
 
+use crate::odometry::{Odometries, Outcome};
+use crate::odometry_config::OdometryConfig;
 use crate::templates::{AppearanceTemplate, build_into};
 
 /// A worker's kernels and their buffers.
@@ -35,6 +37,9 @@ pub struct Dispatcher {
     hypotheses: Vec<Hypothesis>,
     dock_scratch: HoughScratch,
     poles: Vec<[f32; 6]>,
+    odometries: Odometries,
+    /// The last stereo odometry request found no motion (its items say why).
+    unsolved: bool,
     seq: u64,
 }
 
@@ -63,6 +68,13 @@ impl Dispatcher {
         self.seq = seq;
     }
 
+    /// Stereo odometry requests are answered with `odometry`'s settings (without: refused as a
+    /// bad parameter).
+    pub fn with_odometry(mut self, odometry: Option<OdometryConfig>) -> Self {
+        self.odometries = Odometries::new(odometry);
+        self
+    }
+
     pub fn new(world: World) -> Self {
         Self {
             world,
@@ -82,6 +94,8 @@ impl Dispatcher {
             hypotheses: Vec::new(),
             dock_scratch: HoughScratch::default(),
             poles: Vec::new(),
+            odometries: Odometries::default(),
+            unsolved: false,
             seq: 0,
         }
     }
@@ -96,8 +110,9 @@ impl Dispatcher {
             algorithm: req.algorithm,
             ..Default::default()
         };
+        self.unsolved = false;
         let status = match self.run(h, pixels, req, &mut out) {
-            Ok(()) if out.found == 0 => VisionStatus::NotFound,
+            Ok(()) if out.found == 0 || self.unsolved => VisionStatus::NotFound,
             Ok(()) => VisionStatus::Found,
             Err(s) => s,
         };
@@ -135,13 +150,7 @@ impl Dispatcher {
         }
         .map_err(|e| status_of(&e))?;
         let window = window_of(req, w, ht)?;
-        let mut push = |values: [f32; 6]| {
-            if (out.count as usize) < MAX_VISION_ITEMS {
-                out.items[out.count as usize] = VisionItem { values };
-                out.count += 1;
-            }
-            out.found += 1;
-        };
+        let mut push = |values: [f32; 6]| push_item(out, values);
         match algorithm {
             VisionAlgorithm::Moravec => {
                 let p = MoravecParams {
@@ -267,6 +276,10 @@ impl Dispatcher {
                     push([a.centroid[0], a.centroid[1], a.strength, 0.0, 0.0, 0.0]);
                 }
             }
+            VisionAlgorithm::StereoOdometry => {
+                let outcome = self.odometries.answer(&self.world, h, pixels, req, &mut push)?;
+                self.unsolved = outcome == Outcome::NoSolution;
+            }
             VisionAlgorithm::Correlate => {
                 let l = self
                     .world
@@ -302,6 +315,15 @@ impl Dispatcher {
         }
         Ok(())
     }
+}
+
+/// Adds an item to `out` (counted in `found` when there is no room left).
+fn push_item(out: &mut VisionResult, values: [f32; 6]) {
+    if (out.count as usize) < MAX_VISION_ITEMS {
+        out.items[out.count as usize] = VisionItem { values };
+        out.count += 1;
+    }
+    out.found += 1;
 }
 
 /// The request's window: all zeros for the whole frame; one that leaves the frame is an error.

@@ -7,6 +7,8 @@ use harvey_msgs::{Detections, Feature, FrameHeader, Header, MAX_FEATURES};
 /// Algorithm ids carried in [`Detections::algorithm`].
 pub mod dispatch;
 pub mod landmarks;
+pub mod odometry;
+pub mod odometry_config;
 pub mod poles;
 pub mod selection;
 pub mod templates;

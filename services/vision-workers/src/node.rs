@@ -7,6 +7,7 @@ use clap::Parser;
 use crate::VerticalEdges;
 use crate::dispatch::Dispatcher;
 use crate::landmarks::LineLandmarks;
+use crate::odometry_config::OdometryConfig;
 use harvey_msgs::{
     Detections, Expectation, LandmarkSighting, VisionAlgorithm, VisionRequest, VisionResult, topics,
 };
@@ -41,6 +42,10 @@ pub struct Args {
     /// The window of the `--lines` request, `U0,V0,U1,V1` pixels (default: the whole frame).
     #[arg(long, value_delimiter = ',')]
     pub lines_window: Option<Vec<f32>>,
+    /// The stereo visual odometry's settings: a file's `[odometry]` table
+    /// (`missions/odometry/003.toml`). Without it, odometry requests are refused.
+    #[arg(long)]
+    pub odometry: Option<PathBuf>,
 }
 
 /// `K/N` with `K < N`.
@@ -179,6 +184,7 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<Workers> {
     let shard = shard(&args.shard)?;
     let own = own_request(&args)?;
     let world = harvey_world::World::load(&args.world)?;
+    let odometry = args.odometry.as_deref().map(OdometryConfig::load).transpose()?;
     let frames = p.frames(topics::CAMERA_FRAME);
     // In real time a turn is as late as the newest of these.
     p.time_from_frames(frames);
@@ -198,7 +204,7 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<Workers> {
         lines: LineLandmarks::new(world.camera.focal_px, args.edge_threshold)
             .with_calibration_sd(world.survey.calibration_sd_rad)
             .with_blur(world.camera.blur_px),
-        dispatcher: Dispatcher::new(world.clone()),
+        dispatcher: Dispatcher::new(world.clone()).with_odometry(odometry),
         camera: world.camera,
         new_expectations: Vec::new(),
         new_requests: Vec::new(),

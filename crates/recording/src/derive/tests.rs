@@ -120,14 +120,7 @@ fn a_continued_recording_gets_only_the_derived_messages_it_lacks() {
 #[test]
 fn each_frame_brings_its_calibration_with_the_world_and_none_without() {
     let world = world();
-    let h = harvey_msgs::FrameHeader {
-        seq: 3,
-        stamp_ns: 7,
-        width_px: 320,
-        height_px: 240,
-        stride_bytes: 320,
-        encoding: harvey_msgs::Encoding::Mono8 as u32,
-    };
+    let h = harvey_msgs::FrameHeader::new(3, 7, 320, 240, harvey_msgs::Encoding::Mono8);
     let frame = harvey_cdr::encode_image(&h, &vec![0u8; 320 * 240], Vec::new());
     let mut out = Vec::new();
     Deriver::new(None).derive(topics::CAMERA_FRAME.name, 7, &frame, &mut out).expect("derives");

@@ -1,8 +1,8 @@
-//! The viewer layout a Harvey recording opens with: the camera with the Expecter's windows, the
-//! log (one entity per source, so the source shows in its column) and the state lanes (mission
-//! step, servoing level, acceptor state, UMS localised or lost) down the left; the world view
-//! framed on the action (a tab for the whole world) and one plot per quantity, each titled with
-//! its unit, down the right.
+//! The viewer layout a Harvey recording opens with: the camera with the Expecter's windows (a
+//! stereo pair's right image in a tab beside it), the log (one entity per source, so the source
+//! shows in its column) and the state lanes (mission step, servoing level, acceptor state, UMS
+//! localised or lost) down the left; the world view framed on the action (a tab for the whole
+//! world) and one plot per quantity, each titled with its unit, down the right.
 
 use rerun::blueprint::components::PanelState;
 use rerun::blueprint::{
@@ -36,8 +36,16 @@ pub fn harvey() -> Blueprint {
             .with_contents(["+ /world/**", "- /world/near/**"])
             .into(),
     ]);
+    // A stereo pair's right image in a tab of its own (the overlays are the left image's).
+    let camera = Tabs::new([
+        Spatial2DView::new("camera")
+            .with_origin("/camera")
+            .with_contents(["+ /camera/**", "- /camera/right/**"])
+            .into(),
+        Spatial2DView::new("right camera (stereo)").with_origin("/camera/right").into(),
+    ]);
     let left = Vertical::new([
-        Spatial2DView::new("camera").with_origin("/camera").into(),
+        camera.into(),
         TextLogView::new("log").with_origin("/log").into(),
         StateTimelineView::new("mission, servoing, acceptor, UMS").with_origin("/states").into(),
     ])

@@ -25,11 +25,17 @@ impl RrdWriter {
         self.at(h.stamp_ns);
         self.rec.set_time_sequence("frame", h.seq as i64);
         let size = [h.width_px, h.height_px];
-        let image = match h.encoding() {
-            Some(harvey_msgs::Encoding::Rgb8) => rerun::Image::from_rgb24(pixels.to_vec(), size),
-            _ => rerun::Image::from_l8(pixels.to_vec(), size),
-        };
-        self.rec.log("camera/image", &image).map_err(|e| self.err(e))
+        // The left view (the only one of a single camera) under the overlays, which are in its
+        // pixels; a stereo pair's right view beside it.
+        for (k, entity) in [(0, "camera/image"), (1, "camera/right")] {
+            let Some(view) = h.view(pixels, k) else { continue };
+            let image = match h.encoding() {
+                Some(harvey_msgs::Encoding::Rgb8) => rerun::Image::from_rgb24(view.to_vec(), size),
+                _ => rerun::Image::from_l8(view.to_vec(), size),
+            };
+            self.rec.log(entity, &image).map_err(|e| self.err(e))?;
+        }
+        Ok(())
     }
 
     fn landmark_name(&self, index: u32) -> String {

@@ -1,6 +1,6 @@
 //! How vision results are drawn on the camera image: lines, corners, region centroids, the dock,
-//! poles and correlation matches (a line from where the vertex was expected to where it was
-//! found), one entity per request, taken off once stale; labels only where a result has a few
+//! poles, correlation matches (a line from where the vertex was expected to where it was
+//! found) and the stereo odometry's obstacle points, one entity per request, taken off once stale; labels only where a result has a few
 //! items; the light blob's size as a plot; failed requests go to the log.
 
 use harvey_msgs::{VisionAlgorithm, VisionResult, VisionStatus};
@@ -96,6 +96,26 @@ impl RrdWriter {
                     .map(|i| vec![[i.values[3], i.values[4]], [i.values[0], i.values[1]]])
                     .collect();
                 self.rec.log(path.as_str(), &rerun::LineStrips2D::new(moves).with_colors([colour]))
+            }
+            Some(VisionAlgorithm::StereoOdometry) => {
+                // The obstacle points (after the motion and the counts) where the left image
+                // sees them, the nearest labelled with their distance.
+                let obstacles = items.get(2..).unwrap_or_default();
+                let pts: Vec<[f32; 2]> = obstacles.iter().map(|i| [i.values[4], i.values[5]]).collect();
+                let labels: Vec<String> = obstacles
+                    .iter()
+                    .enumerate()
+                    .map(|(k, i)| {
+                        if k < LABELLED {
+                            format!("{:.1} m", i.values[0].hypot(i.values[1]))
+                        } else {
+                            String::new()
+                        }
+                    })
+                    .collect();
+                let drawn =
+                    rerun::Points2D::new(pts).with_labels(labels).with_radii([3.0]).with_colors([colour]);
+                self.rec.log(path.as_str(), &drawn)
             }
             None => return Ok(()),
         };

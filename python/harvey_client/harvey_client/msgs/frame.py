@@ -10,7 +10,8 @@ BYTES_PER_PIXEL = {1: 1, 2: 3}
 
 class FrameHeader(Message):
     """The user header of a camera frame; the pixels follow as the sample's `[u8]` payload,
-    `height_px` rows of `stride_bytes` each."""
+    `height_px` rows of `stride_bytes` each, once per view (a stereo pair: `views` 2, the left
+    image then the right one)."""
 
     _fields_ = [
         ("seq", c_u64),
@@ -19,6 +20,8 @@ class FrameHeader(Message):
         ("height_px", c_u32),
         ("stride_bytes", c_u32),
         ("encoding", c_u32),
+        ("views", c_u32),
+        ("reserved", c_u32),
     ]
     _type_name = "harvey_msgs/FrameHeader"
 
@@ -26,5 +29,9 @@ class FrameHeader(Message):
     def encoding_name(self) -> str:
         return ENCODINGS.get(self.encoding, "")
 
+    def view_count(self) -> int:
+        """How many images the frame carries (0 from an older writer means one)."""
+        return max(1, self.views)
+
     def payload_len(self) -> int:
-        return self.stride_bytes * self.height_px
+        return self.stride_bytes * self.height_px * self.view_count()
