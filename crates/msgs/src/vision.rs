@@ -62,8 +62,8 @@ pub enum VisionAlgorithm {
     /// deviations x, y (m), heading (rad) (zeros: the worker's `--odometry` settings). The
     /// window is not used. Items: `[dx, dy, dheading, sd_x, sd_y, sd_heading]` the motion
     /// (zeros unless solved), `[features, used, carried, reacquired, pruned, error_scale]`,
-    /// then obstacle points `[x, y, z, range_sd, u, v]` in this stop's robot frame, nearest
-    /// first. `NotFound`: no motion solution (too few features held; the next frame is solved
+    /// then obstacle points `[x, y, z, range_sd, u, v]` in this stop's robot frame (features
+    /// that held since the last stop: none at a start), nearest first. `NotFound`: no motion solution (too few features held; the next frame is solved
     /// against this one). A mono frame is a bad frame; a world without a stereo baseline or a
     /// worker without settings, a bad parameter.
     StereoOdometry = 9,

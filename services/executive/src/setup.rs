@@ -9,6 +9,7 @@ use harvey_world::{World, WorldError};
 
 use crate::behaviours::docking::Docking;
 use crate::behaviours::fsa::{Fsa, FsaError};
+use crate::behaviours::neptune::Neptune;
 use crate::behaviours::pole_hunt::PoleHunt;
 use crate::behaviours::{Behaviour, Run};
 use crate::mission::{self, Mission, MissionError};
@@ -238,9 +239,14 @@ impl Site<'_> {
         Ok(fsa)
     }
 
-    /// The docking behaviour or the pole hunt: the acceptor, the camera, the sonar, the seed.
+    /// The docking behaviour or the pole hunt (the acceptor, the camera, the sonar, the seed),
+    /// or CMU's navigation (its start).
     fn behaviour(&self, seed: u64) -> Result<Option<Behaviour>, SetupError> {
         let m = self.mission;
+        if let Some(g) = &m.neptune {
+            let start = self.world("[mission.neptune]")?.start;
+            return Ok(Some(Behaviour::Neptune(Box::new(Neptune::new(g.clone(), start)))));
+        }
         let key = match (&m.docking, &m.poles) {
             (Some(_), _) => "[mission.docking]",
             (None, Some(_)) => "[mission.poles]",

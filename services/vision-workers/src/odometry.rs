@@ -49,7 +49,8 @@ impl Odometries {
     /// Runs `req` on the stereo frame `h`/`pixels`: pushes the motion `[dx, dy, dheading, sd_x,
     /// sd_y, sd_heading]` (zeros unless solved), the counts `[features, used, carried,
     /// reacquired, pruned, error_scale]`, then the obstacle points `[x, y, z, range_sd, u, v]`
-    /// (this stop's robot frame, nearest first).
+    /// (the features that held since the last stop, between the settings' heights; this stop's
+    /// robot frame, nearest first).
     pub fn answer(
         &mut self,
         world: &World,
@@ -109,7 +110,9 @@ impl Odometries {
         self.points.clear();
         let rig = run.params.rig;
         let (lo, hi) = (config.obstacle_min_z_m, config.obstacle_max_z_m);
-        for (at, p) in run.vo.features().filter(|(_, p)| (lo..=hi).contains(&p[2])) {
+        // Only points seen from two stops: a single stereo match may be a blunder (an occluding
+        // edge matched against what is behind it).
+        for (at, p) in run.vo.held().filter(|(_, p)| (lo..=hi).contains(&p[2])) {
             let v = [p[0], p[1], p[2], rig.range_sd(p)].map(|v| v as f32);
             self.points.push([v[0], v[1], v[2], v[3], at[0], at[1]]);
         }

@@ -105,6 +105,9 @@ pub struct VisualOdometry {
     /// The reacquisition's template, its buffers reused from feature to feature.
     template: Option<Template>,
     features: Vec<Feature>,
+    /// How many of `features` (the first) held at the last stop: found again, rigid and
+    /// agreeing with the motion (none after a start).
+    held: usize,
     size: Option<[usize; 2]>,
     pairs: Vec<Pair>,
     found: Vec<Feature>,
@@ -121,6 +124,7 @@ impl VisualOdometry {
             correlator: Correlator::default(),
             template: None,
             features: Vec::new(),
+            held: 0,
             size: None,
             pairs: Vec::new(),
             found: Vec::new(),
@@ -134,9 +138,16 @@ impl VisualOdometry {
         self.features.iter().map(|f| (f.at, f.point))
     }
 
+    /// The features that held at the last stop (found again, rigid with the others and agreeing
+    /// with the motion): points seen from two stops, not a single match that may be a blunder.
+    pub fn held(&self) -> impl Iterator<Item = ([f32; 2], [f64; 3])> + '_ {
+        self.features().take(self.held)
+    }
+
     /// The first stop (or a fresh start): ranges the pair's features; returns how many.
     pub fn start(&mut self, left: &Gray<'_>, right: &Gray<'_>) -> Result<usize, OdometryError> {
         self.features.clear();
+        self.held = 0;
         self.size = Some([left.width, left.height]);
         if let Solver::Lucas(lp) = self.params.solver {
             self.pyramids[0].build(left, lp.levels)?;
@@ -198,6 +209,7 @@ impl VisualOdometry {
         self.features.clear();
         self.features.extend(held.drain(..).zip(&active).filter(|(_, a)| **a).map(|(f, _)| f));
         self.found = held;
+        self.held = self.features.len();
         let solution = match solved {
             Ok(s) => s,
             Err(e) => {

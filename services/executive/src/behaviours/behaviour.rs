@@ -1,5 +1,6 @@
 //! The acceptor-sequenced behaviours a mission may run instead of a script or a plan (004):
-//! docking and the pole hunt, behind one face, and run as the executive's mode.
+//! docking and the pole hunt, and CMU's stop-go-stop navigation (003), behind one face, and
+//! run as the executive's mode.
 
 use harvey_msgs::{
     BehaviourState, MissionState, MotionCommand, Odometry, Pose2, ServoLevel, SonarRing, UncertaintyMap,
@@ -7,6 +8,7 @@ use harvey_msgs::{
 };
 
 use super::docking::Docking;
+use super::neptune::Neptune;
 use super::pole_hunt::PoleHunt;
 use crate::{Output, Progress};
 
@@ -14,6 +16,7 @@ use crate::{Output, Progress};
 pub enum Behaviour {
     Docking(Box<Docking>),
     Poles(Box<PoleHunt>),
+    Neptune(Box<Neptune>),
 }
 
 impl Behaviour {
@@ -21,6 +24,7 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.on_sonar(r),
             Self::Poles(p) => p.on_sonar(r),
+            Self::Neptune(n) => n.on_sonar(r),
         }
     }
 
@@ -35,6 +39,7 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.on_vision(r),
             Self::Poles(p) => p.on_vision(r),
+            Self::Neptune(n) => n.on_vision(r),
         }
     }
 
@@ -47,6 +52,7 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.on_odometry(odometry, now),
             Self::Poles(p) => p.on_odometry(odometry, now),
+            Self::Neptune(n) => n.on_odometry(odometry, now),
         }
     }
 
@@ -55,13 +61,14 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.done,
             Self::Poles(p) => p.done,
+            Self::Neptune(n) => n.done,
         }
     }
 
     /// Whether the mission counts as succeeded if its time runs out now.
     pub fn enough_at_timeout(&self) -> bool {
         match self {
-            Self::Docking(_) => false,
+            Self::Docking(_) | Self::Neptune(_) => false,
             Self::Poles(p) => p.enough(),
         }
     }
@@ -70,6 +77,7 @@ impl Behaviour {
     pub fn believed(&self, odometry: Pose2) -> Pose2 {
         match self {
             Self::Docking(d) => d.believed(),
+            Self::Neptune(n) => n.believed(),
             Self::Poles(_) => odometry,
         }
     }
@@ -78,6 +86,7 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.goal_pose(),
             Self::Poles(p) => p.goal_pose(),
+            Self::Neptune(n) => n.goal_pose(),
         }
     }
 }

@@ -3,13 +3,16 @@
 //! perceptual algorithm, and motor schemas (`schemas.rs`, on the robot in `drive.rs`) drive.
 //! Docking (`docking.rs`, the pose from the dock in `dock_pose.rs`, judged by the UMS's region in
 //! `region.rs`) and the pole hunt
-//! (`pole_hunt.rs`) behind one face (`behaviour.rs`).
+//! (`pole_hunt.rs`) behind one face (`behaviour.rs`), with CMU's stop-go-stop navigation by
+//! stereo (003, `neptune.rs`, its path round the obstacles seen in `grid_plan.rs`).
 
 pub mod behaviour;
 pub mod dock_pose;
 pub mod docking;
 pub mod drive;
 pub mod fsa;
+pub mod grid_plan;
+pub mod neptune;
 pub mod pole_hunt;
 pub mod region;
 pub mod schemas;

@@ -84,6 +84,9 @@ pub(crate) fn check_bounds(m: &Mission) -> Result<(), OutOfRange> {
     if let Some(p) = &m.poles {
         super::bounds_goals::check_poles(&root("poles"), p)?;
     }
+    if let Some(n) = &m.neptune {
+        super::bounds_goals::check_neptune(&root("neptune"), n)?;
+    }
     Ok(())
 }
 

@@ -1,9 +1,9 @@
 //! The ranges of the goal tables' numbers (`[mission.ptrans]`, `[mission.docking]`,
-//! `[mission.poles]`): finite and inside what the behaviours can do, checked before the
+//! `[mission.poles]`, `[mission.neptune]`): finite and inside what the behaviours can do, checked before the
 //! tables' own checks of how their numbers fit together (`goals.rs`).
 
 use super::bounds::{ANGLE, LENGTH, LENGTH_OR_ZERO, POSITION, TIMEOUT};
-use super::goals::{DockingGoal, PolesGoal, PtransGoal};
+use super::goals::{DockingGoal, NeptuneGoal, PolesGoal, PtransGoal};
 use harvey_config::range::{OutOfRange, Range, check, check_all, check_int};
 use harvey_config::spans::KeyPath;
 
@@ -41,6 +41,26 @@ const MAX_TICKS: u32 = 1_000_000;
 const MAX_ATTEMPTS: u32 = 1_000;
 /// Poles of an arena: the world crate's cap on `[poles] count`.
 const MAX_POLES: u32 = 100;
+
+pub(crate) fn check_neptune(k: &KeyPath, n: &NeptuneGoal) -> Result<(), OutOfRange> {
+    check_all(&k.key("goal_m"), &n.goal_m, &POSITION)?;
+    check(&k.key("goal_tolerance_m"), n.goal_tolerance_m, &LENGTH)?;
+    check(&k.key("step_m"), n.step_m, &LENGTH)?;
+    check(&k.key("settle_s"), n.settle_s, &WAIT)?;
+    check(&k.key("clearance_m"), n.clearance_m, &SIZE)?;
+    check(&k.key("hard_clearance_m"), n.hard_clearance_m, &SIZE)?;
+    check(&k.key("shadow_m"), n.shadow_m, &HEIGHT)?;
+    // A planning cell: at least a centimetre (the grid is capped at 2000 cells a side).
+    check(&k.key("cell_m"), n.cell_m, &Range::closed(0.01, 10.0, "m"))?;
+    check_all(&k.key("room_min_m"), &n.room_min_m, &POSITION)?;
+    check_all(&k.key("room_max_m"), &n.room_max_m, &POSITION)?;
+    check(&k.key("speed_mps"), n.speed_mps, &SPEED)?;
+    check(&k.key("max_turn_degps"), n.max_turn_degps, &TURN_RATE)?;
+    check(&k.key("turn_gain"), n.turn_gain, &TURN_GAIN)?;
+    check(&k.key("arrive_m"), n.arrive_m, &LENGTH)?;
+    check(&k.key("aligned_deg"), n.aligned_deg, &HALF_TURN)?;
+    check(&k.key("max_step_turn_deg"), n.max_step_turn_deg, &HALF_TURN)
+}
 
 pub(crate) fn check_ptrans(k: &KeyPath, p: &PtransGoal) -> Result<(), OutOfRange> {
     check_all(&k.key("goal_m"), &p.goal_m, &POSITION)?;

@@ -1,6 +1,7 @@
 //! The goal tables of the missions that make their own steps: `[mission.ptrans]` for
 //! plan-and-monitor (000 §2), `[mission.docking]` and `[mission.poles]` for the behaviours that
-//! finite state acceptors sequence (004 §4.2, §5), each with its checks.
+//! finite state acceptors sequence (004 §4.2, §5), `[mission.neptune]` for CMU's stop-go-stop
+//! stereo navigation (003), each with its checks.
 
 use serde::Deserialize;
 
@@ -154,6 +155,59 @@ pub struct PolesGoal {
     pub past_decay: f64,
     pub noise_mps: f64,
     pub noise_ticks: u32,
+}
+
+/// CMU's stop-go-stop navigation by stereo alone (`[mission.neptune]`, 003): to the goal in
+/// steps, looking at each stop, the position model from visual odometry, the path planned round
+/// the obstacles stereo saw.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NeptuneGoal {
+    /// The goal on the floor (m), and how near the position model must put the robot.
+    pub goal_m: [f64; 2],
+    pub goal_tolerance_m: f64,
+    /// The longest step between stops (m), and the stillness awaited before a look (s).
+    pub step_m: f64,
+    pub settle_s: f64,
+    /// Lucas registration instead of match-then-solve.
+    pub lucas: bool,
+    /// Obstacles make the path dear within this of their points (a margin) and dearer within
+    /// `hard_clearance_m` (the robot's reach); dear, not impassable, so a robot in a margin
+    /// plans its way out.
+    pub clearance_m: f64,
+    pub hard_clearance_m: f64,
+    /// What stereo cannot see behind an obstacle's face counts as the obstacle this far on.
+    pub shadow_m: f64,
+    /// The planning grid's cell (m) and the room's extent (m), which the robot knows.
+    pub cell_m: f64,
+    pub room_min_m: [f64; 2],
+    pub room_max_m: [f64; 2],
+    /// Driving between stops: speed (m/s), turn rate (degrees/s) and its gain (per second); a
+    /// step's target counts as reached this near (m) and a turn this near (degrees).
+    pub speed_mps: f64,
+    pub max_turn_degps: f64,
+    pub turn_gain: f64,
+    pub arrive_m: f64,
+    pub aligned_deg: f64,
+    /// A wider turn is a step of its own (a stop to look after it), so that two stops' views
+    /// share enough features.
+    pub max_step_turn_deg: f64,
+}
+
+pub(crate) fn check_neptune(n: &NeptuneGoal) -> Result<(), &'static str> {
+    if n.hard_clearance_m > n.clearance_m {
+        return Err("hard_clearance_m is more than clearance_m");
+    }
+    if (0..2).any(|k| n.room_min_m[k] >= n.room_max_m[k]) {
+        return Err("room_min_m is not below room_max_m");
+    }
+    if (0..2).any(|k| n.goal_m[k] <= n.room_min_m[k] || n.goal_m[k] >= n.room_max_m[k]) {
+        return Err("goal_m is outside the room");
+    }
+    if n.arrive_m >= n.step_m {
+        return Err("arrive_m is not less than step_m");
+    }
+    Ok(())
 }
 
 pub(crate) fn check_ptrans(p: &PtransGoal) -> Result<(), &'static str> {

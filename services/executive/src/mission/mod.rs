@@ -12,8 +12,8 @@ mod error;
 pub mod goals;
 
 pub use error::MissionError;
-pub use goals::{DockingGoal, PolesGoal, PtransGoal};
-use goals::{check_docking, check_poles, check_ptrans};
+pub use goals::{DockingGoal, NeptuneGoal, PolesGoal, PtransGoal};
+use goals::{check_docking, check_neptune, check_poles, check_ptrans};
 
 /// One primitive: exactly one of `move_m` and `turn_deg` is set. A move may be driven in
 /// increments, and servoed on a landmark after each (000 §5.5).
@@ -107,6 +107,7 @@ pub struct Mission {
     pub ptrans: Option<PtransGoal>,
     pub docking: Option<DockingGoal>,
     pub poles: Option<PolesGoal>,
+    pub neptune: Option<NeptuneGoal>,
 }
 
 #[derive(Deserialize)]
@@ -135,8 +136,10 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
     if !greater(m.timeout_s, 0.0) {
         return Err(MissionError::Timeout { file: file_name() });
     }
-    let behaviours =
-        usize::from(m.ptrans.is_some()) + usize::from(m.docking.is_some()) + usize::from(m.poles.is_some());
+    let behaviours = usize::from(m.ptrans.is_some())
+        + usize::from(m.docking.is_some())
+        + usize::from(m.poles.is_some())
+        + usize::from(m.neptune.is_some());
     match (behaviours, m.steps.is_empty()) {
         (0, true) => return Err(MissionError::NothingToDo { file: file_name() }),
         (1, true) | (0, false) => {}
@@ -151,6 +154,9 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
     }
     if let Some(d) = &m.docking {
         check_docking(d).map_err(|what| goal("docking", what))?;
+    }
+    if let Some(n) = &m.neptune {
+        check_neptune(n).map_err(|what| goal("neptune", what))?;
     }
     for (index, s) in m.steps.iter().enumerate() {
         match (s.move_m, s.turn_deg, s.refine_pose) {

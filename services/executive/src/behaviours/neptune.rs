@@ -1,0 +1,292 @@
+//! CMU's stop-go-stop visual navigation (003, Neptune): at each stop the robot stands still and
+//! looks (a stereo odometry request, the motion since the last look predicted by the encoders as
+//! the paper's planner predicted it); the position model moves by the motion stereo solved (by
+//! the prediction when it solved none: a stop counted unsolved), the obstacle points join the
+//! map, a path is planned round them to the goal, and the robot goes a step along it: turns
+//! towards the step's end, drives to it by the encoders, and stops to look again.
+
+use harvey_geometry::wrap;
+use harvey_msgs::{
+    BehaviourState, Header, MotionCommand, Pose2, SonarRing, VisionAlgorithm, VisionRequest, VisionResult,
+    VisionStatus,
+};
+
+use super::drive;
+use super::grid_plan::{Grid, along};
+use crate::mission::NeptuneGoal;
+
+/// The odometry request's id: the vision workers keep one odometry per id.
+pub const REQUEST_ID: u32 = 3003;
+
+/// A turn or a drive taking `s` seconds unhindered is given up after twice that and 3 s more
+/// (the sonar's reflexes hold the robot back while something is near).
+fn allowance(s: f64) -> u64 {
+    ((2.0 * s + 3.0) * 1e9) as u64
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Phase {
+    /// Standing still since then (the first tick sets it), before a look.
+    Settling {
+        since_ns: Option<u64>,
+    },
+    Looking,
+    /// Towards the step's end, in the encoders' frame; given up (to look again) at the deadline
+    /// (0: not set yet), when a reflex has held the robot back. A turn-only step (`then_move`
+    /// false), one too wide for two stops' views to share enough, ends in a look.
+    Turning {
+        to: [f64; 2],
+        deadline_ns: u64,
+        then_move: bool,
+    },
+    Moving {
+        to: [f64; 2],
+        deadline_ns: u64,
+    },
+}
+
+/// The navigation's state.
+#[derive(Debug, Clone)]
+pub struct Neptune {
+    g: NeptuneGoal,
+    phase: Phase,
+    /// The position model (world frame) at the last look, from stereo alone.
+    model: Pose2,
+    /// The encoders' pose at the last look, and now.
+    looked_at: Option<Pose2>,
+    at: Pose2,
+    ring: Option<SonarRing>,
+    /// Obstacle points seen (world frame, m), each with where it was seen from.
+    obstacles: Vec<([f64; 2], [f64; 2])>,
+    /// Looks answered, and those whose motion came from the prediction.
+    pub stops: u32,
+    pub unsolved: u32,
+    next_id: u32,
+    seq: u64,
+    pub done: Option<bool>,
+}
+
+impl Neptune {
+    pub fn new(g: NeptuneGoal, start: Pose2) -> Self {
+        Self {
+            g,
+            phase: Phase::Settling { since_ns: None },
+            model: start,
+            looked_at: None,
+            at: start,
+            ring: None,
+            obstacles: Vec::new(),
+            stops: 0,
+            unsolved: 0,
+            next_id: 1,
+            seq: 0,
+            done: None,
+        }
+    }
+
+    pub fn on_sonar(&mut self, r: &SonarRing) {
+        self.ring = Some(*r);
+    }
+
+    /// The position model carried on by the encoders since the last look.
+    pub fn believed(&self) -> Pose2 {
+        match self.looked_at {
+            Some(l) => self.model.compose(&l.relative(&self.at)),
+            None => self.model,
+        }
+    }
+
+    pub fn goal_pose(&self) -> Pose2 {
+        Pose2 { x_m: self.g.goal_m[0], y_m: self.g.goal_m[1], heading_rad: 0.0 }
+    }
+
+    /// The answer to the look: the model moved, the obstacles mapped, the next step planned.
+    pub fn on_vision(&mut self, r: &VisionResult) {
+        if r.request_id != REQUEST_ID || self.phase != Phase::Looking {
+            return;
+        }
+        let predicted = self.looked_at.map(|l| l.relative(&self.at));
+        let items = &r.items[..(r.count as usize).min(r.items.len())];
+        let status = VisionStatus::from_raw(r.status);
+        // Solved: the motion; else (none solved, or a worker that started afresh) the prediction.
+        let solved = status == Some(VisionStatus::Found) && items.len() >= 2 && items[1].values[2] > 0.0;
+        let motion = match (solved, predicted) {
+            (true, _) => {
+                let [dx, dy, dh, ..] = items[0].values.map(f64::from);
+                Some(Pose2 { x_m: dx, y_m: dy, heading_rad: dh })
+            }
+            (false, Some(p)) => {
+                self.unsolved += 1;
+                tracing::warn!(
+                    stop = self.stops,
+                    ?status,
+                    "no motion from stereo: the stop is dead reckoned"
+                );
+                Some(p)
+            }
+            (false, None) => None,
+        };
+        if let Some(m) = motion {
+            self.model = self.model.compose(&m);
+        }
+        self.stops += 1;
+        self.looked_at = Some(self.at);
+        if status == Some(VisionStatus::Found) || status == Some(VisionStatus::NotFound) {
+            let (model, from) = (self.model, [self.model.x_m, self.model.y_m]);
+            let seen =
+                items.iter().skip(2).map(|i| model.apply([f64::from(i.values[0]), f64::from(i.values[1])]));
+            self.obstacles.extend(seen.map(|p| (p, from)));
+        }
+        let here = [self.model.x_m, self.model.y_m];
+        if (here[0] - self.g.goal_m[0]).hypot(here[1] - self.g.goal_m[1]) <= self.g.goal_tolerance_m {
+            tracing::info!(stops = self.stops, unsolved = self.unsolved, "at the goal");
+            self.done = Some(true);
+            return;
+        }
+        let Some(target) = self.plan(here) else {
+            tracing::warn!(stops = self.stops, "the position model has left the room: no path to the goal");
+            self.done = Some(false);
+            return;
+        };
+        // A turn wider than the views allow is a step of its own, towards the target.
+        let e = wrap((target[1] - here[1]).atan2(target[0] - here[0]) - self.model.heading_rad);
+        let widest = self.g.max_step_turn_deg.to_radians();
+        let (target, then_move) = if e.abs() <= widest {
+            (target, true)
+        } else {
+            let towards = self.model.heading_rad + widest.copysign(e);
+            ([here[0] + towards.cos(), here[1] + towards.sin()], false)
+        };
+        // The step's end in the encoders' frame, where the robot drives by them.
+        let odo_from_world = self.at.compose(&self.model.inverse());
+        self.phase = Phase::Turning { to: odo_from_world.apply(target), deadline_ns: 0, then_move };
+    }
+
+    /// The end of the next step: `step_m` along the cheapest path round the obstacles, their
+    /// clearance a margin and their hard clearance the robot's reach. Stereo sees an obstacle's
+    /// face, not what is behind it: each point also blocks its shadow, `shadow_m` on along the
+    /// ray it was seen by (the body of a box seen from the front).
+    fn plan(&self, here: [f64; 2]) -> Option<[f64; 2]> {
+        let g = &self.g;
+        let samples = (g.shadow_m / (g.cell_m / 2.0)).ceil().max(1.0) as usize;
+        let mut grid = Grid::new(g.room_min_m, g.room_max_m, g.cell_m);
+        for (p, from) in &self.obstacles {
+            let (dx, dy) = (p[0] - from[0], p[1] - from[1]);
+            let d = dx.hypot(dy).max(1e-9);
+            for k in 0..=samples {
+                let s = g.shadow_m * k as f64 / samples as f64;
+                let at = [p[0] + dx / d * s, p[1] + dy / d * s];
+                grid.block(at, g.clearance_m, 1);
+                grid.block(at, g.hard_clearance_m, 2);
+            }
+        }
+        grid.path(here, g.goal_m).map(|path| along(here, &path, g.step_m))
+    }
+
+    /// One odometry tick: the look to send, the velocity command and the state to publish.
+    pub fn on_odometry(
+        &mut self,
+        at: Pose2,
+        now: u64,
+    ) -> (Option<VisionRequest>, MotionCommand, BehaviourState) {
+        self.at = at;
+        let g = &self.g;
+        let max_turn = g.max_turn_degps.to_radians();
+        let mut look = None;
+        let vw = match self.phase {
+            Phase::Settling { since_ns: None } => {
+                self.phase = Phase::Settling { since_ns: Some(now) };
+                (0.0, 0.0)
+            }
+            Phase::Settling { since_ns: Some(t) } => {
+                if now >= t + (g.settle_s * 1e9) as u64 && self.done.is_none() {
+                    look = Some(self.look(now));
+                    self.phase = Phase::Looking;
+                }
+                (0.0, 0.0)
+            }
+            Phase::Looking => (0.0, 0.0),
+            Phase::Turning { to, deadline_ns, then_move } => {
+                let e = wrap((to[1] - at.y_m).atan2(to[0] - at.x_m) - at.heading_rad);
+                let deadline_ns = match deadline_ns {
+                    0 => now + allowance(e.abs() / max_turn),
+                    d => d,
+                };
+                if e.abs() <= g.aligned_deg.to_radians() {
+                    self.phase = match then_move {
+                        true => Phase::Moving { to, deadline_ns: 0 },
+                        false => Phase::Settling { since_ns: Some(now) },
+                    };
+                    (0.0, 0.0)
+                } else if now >= deadline_ns {
+                    self.phase = Phase::Settling { since_ns: Some(now) };
+                    (0.0, 0.0)
+                } else {
+                    self.phase = Phase::Turning { to, deadline_ns, then_move };
+                    (0.0, (g.turn_gain * e).clamp(-max_turn, max_turn))
+                }
+            }
+            Phase::Moving { to, deadline_ns } => {
+                let (dx, dy) = (to[0] - at.x_m, to[1] - at.y_m);
+                let (s, c) = at.heading_rad.sin_cos();
+                let ahead = c * dx + s * dy;
+                let deadline_ns = match deadline_ns {
+                    0 => now + allowance(dx.hypot(dy) / g.speed_mps),
+                    d => d,
+                };
+                if dx.hypot(dy) <= g.arrive_m || ahead <= 0.0 || now >= deadline_ns {
+                    self.phase = Phase::Settling { since_ns: Some(now) };
+                    (0.0, 0.0)
+                } else {
+                    self.phase = Phase::Moving { to, deadline_ns };
+                    let e = wrap(dy.atan2(dx) - at.heading_rad);
+                    (g.speed_mps.min(ahead), (g.turn_gain * e).clamp(-max_turn, max_turn))
+                }
+            }
+        };
+        let vw = drive::held(self.ring.as_ref(), vw);
+        let id = self.next_id;
+        self.next_id += 1;
+        self.seq += 1;
+        let phase = match self.phase {
+            Phase::Settling { .. } => 0,
+            Phase::Looking => 1,
+            Phase::Turning { .. } => 2,
+            Phase::Moving { .. } => 3,
+        };
+        let state = BehaviourState {
+            header: Header::new(self.seq, now),
+            at: self.believed(),
+            fsa_state: phase,
+            transitions: self.stops,
+            last_trigger: 0,
+            achieved: self.stops - self.unsolved.min(self.stops),
+            vectors_mps: [0.0; 12],
+            linear_mps: vw.0,
+            angular_radps: vw.1,
+        };
+        (look, drive::command(id, now, vw), state)
+    }
+
+    /// The look: the odometry request with the encoders' motion since the last look as the
+    /// prediction (the first look starts the odometry).
+    fn look(&self, now: u64) -> VisionRequest {
+        let expected = self.looked_at.map_or(Pose2::default(), |l| l.relative(&self.at));
+        let start = if self.looked_at.is_none() { 1.0 } else { 0.0 };
+        let mut params = [0.0f32; 8];
+        params[..2].copy_from_slice(&[start, if self.g.lucas { 1.0 } else { 0.0 }]);
+        VisionRequest {
+            header: Header::new(self.seq + 1, now),
+            request_id: REQUEST_ID,
+            algorithm: VisionAlgorithm::StereoOdometry as u32,
+            standing: 0,
+            expected,
+            params,
+            ..VisionRequest::default()
+        }
+    }
+}
+
+#[cfg(test)]
+#[path = "neptune_tests.rs"]
+mod tests;
