@@ -30,7 +30,11 @@ enum Phase {
     Settling {
         since_ns: Option<u64>,
     },
-    Looking,
+    /// Waiting for the answer until then; asked again after it (a worker restarted meanwhile
+    /// has lost the request).
+    Looking {
+        until_ns: u64,
+    },
     /// Towards the step's end, in the encoders' frame; given up (to look again) at the deadline
     /// (0: not set yet), when a reflex has held the robot back. A turn-only step (`then_move`
     /// false), one too wide for two stops' views to share enough, ends in a look.
@@ -102,7 +106,7 @@ impl Neptune {
 
     /// The answer to the look: the model moved, the obstacles mapped, the next step planned.
     pub fn on_vision(&mut self, r: &VisionResult) {
-        if r.request_id != REQUEST_ID || self.phase != Phase::Looking {
+        if r.request_id != REQUEST_ID || !matches!(self.phase, Phase::Looking { .. }) {
             return;
         }
         let predicted = self.looked_at.map(|l| l.relative(&self.at));
@@ -201,11 +205,18 @@ impl Neptune {
             Phase::Settling { since_ns: Some(t) } => {
                 if now >= t + (g.settle_s * 1e9) as u64 && self.done.is_none() {
                     look = Some(self.look(now));
-                    self.phase = Phase::Looking;
+                    self.phase = Phase::Looking { until_ns: now + (g.look_timeout_s * 1e9) as u64 };
                 }
                 (0.0, 0.0)
             }
-            Phase::Looking => (0.0, 0.0),
+            Phase::Looking { until_ns } => {
+                if now >= until_ns {
+                    tracing::warn!(stop = self.stops, "no answer to the look: asking again");
+                    look = Some(self.look(now));
+                    self.phase = Phase::Looking { until_ns: now + (g.look_timeout_s * 1e9) as u64 };
+                }
+                (0.0, 0.0)
+            }
             Phase::Turning { to, deadline_ns, then_move } => {
                 let e = wrap((to[1] - at.y_m).atan2(to[0] - at.x_m) - at.heading_rad);
                 let deadline_ns = match deadline_ns {
@@ -250,7 +261,7 @@ impl Neptune {
         self.seq += 1;
         let phase = match self.phase {
             Phase::Settling { .. } => 0,
-            Phase::Looking => 1,
+            Phase::Looking { .. } => 1,
             Phase::Turning { .. } => 2,
             Phase::Moving { .. } => 3,
         };

@@ -11,6 +11,7 @@ fn goal() -> NeptuneGoal {
         goal_tolerance_m: 0.1,
         step_m: 0.4,
         settle_s: 0.5,
+        look_timeout_s: 2.0,
         lucas: false,
         clearance_m: 0.65,
         hard_clearance_m: 0.45,
@@ -104,6 +105,12 @@ fn the_goal_ends_it_a_held_step_is_given_up_and_a_walled_in_robot_fails() {
         looked |= look.is_some();
     }
     assert!(looked, "the step was given up and the robot looked again");
+    // A look nobody answers is asked again after the timeout.
+    let mut n = Neptune::new(goal(), START);
+    let (_, asked) = until_look(&mut n, START, t);
+    let again: Vec<u64> =
+        (1..=100).map(|k| asked + k * TICK).filter(|&t| n.on_odometry(START, t).0.is_some()).collect();
+    assert_eq!(again, [asked + 40 * TICK, asked + 80 * TICK], "every 2 s");
     // A position model outside the room: no path, and the mission fails.
     let lost = Pose2::new(9.0, 3.0, 0.0);
     let mut n = Neptune::new(goal(), lost);

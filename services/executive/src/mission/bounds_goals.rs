@@ -47,6 +47,7 @@ pub(crate) fn check_neptune(k: &KeyPath, n: &NeptuneGoal) -> Result<(), OutOfRan
     check(&k.key("goal_tolerance_m"), n.goal_tolerance_m, &LENGTH)?;
     check(&k.key("step_m"), n.step_m, &LENGTH)?;
     check(&k.key("settle_s"), n.settle_s, &WAIT)?;
+    check(&k.key("look_timeout_s"), n.look_timeout_s, &WAIT)?;
     check(&k.key("clearance_m"), n.clearance_m, &SIZE)?;
     check(&k.key("hard_clearance_m"), n.hard_clearance_m, &SIZE)?;
     check(&k.key("shadow_m"), n.shadow_m, &HEIGHT)?;

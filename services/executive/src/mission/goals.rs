@@ -169,6 +169,8 @@ pub struct NeptuneGoal {
     /// The longest step between stops (m), and the stillness awaited before a look (s).
     pub step_m: f64,
     pub settle_s: f64,
+    /// A look unanswered this long (s) is asked again.
+    pub look_timeout_s: f64,
     /// Lucas registration instead of match-then-solve.
     pub lucas: bool,
     /// Obstacles make the path dear within this of their points (a margin) and dearer within
@@ -203,6 +205,9 @@ pub(crate) fn check_neptune(n: &NeptuneGoal) -> Result<(), &'static str> {
     }
     if (0..2).any(|k| n.goal_m[k] <= n.room_min_m[k] || n.goal_m[k] >= n.room_max_m[k]) {
         return Err("goal_m is outside the room");
+    }
+    if n.look_timeout_s <= 0.0 {
+        return Err("look_timeout_s is not positive");
     }
     if n.arrive_m >= n.step_m {
         return Err("arrive_m is not less than step_m");
