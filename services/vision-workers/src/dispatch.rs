@@ -38,8 +38,6 @@ pub struct Dispatcher {
     dock_scratch: HoughScratch,
     poles: Vec<[f32; 6]>,
     odometries: Odometries,
-    /// The last stereo odometry request found no motion (its items say why).
-    unsolved: bool,
     seq: u64,
 }
 
@@ -95,7 +93,6 @@ impl Dispatcher {
             dock_scratch: HoughScratch::default(),
             poles: Vec::new(),
             odometries: Odometries::default(),
-            unsolved: false,
             seq: 0,
         }
     }
@@ -110,10 +107,10 @@ impl Dispatcher {
             algorithm: req.algorithm,
             ..Default::default()
         };
-        self.unsolved = false;
+        // `Ok(true)`: items that say why nothing was found (a stereo odometry without a motion).
         let status = match self.run(h, pixels, req, &mut out) {
-            Ok(()) if out.found == 0 || self.unsolved => VisionStatus::NotFound,
-            Ok(()) => VisionStatus::Found,
+            Ok(unsolved) if out.found == 0 || unsolved => VisionStatus::NotFound,
+            Ok(_) => VisionStatus::Found,
             Err(s) => s,
         };
         out.status = status as u32;
@@ -126,7 +123,7 @@ impl Dispatcher {
         pixels: &[u8],
         req: &VisionRequest,
         out: &mut VisionResult,
-    ) -> Result<(), VisionStatus> {
+    ) -> Result<bool, VisionStatus> {
         let algorithm = VisionAlgorithm::from_raw(req.algorithm).ok_or(VisionStatus::UnknownAlgorithm)?;
         let (w, ht) = (h.width_px as usize, h.height_px as usize);
         let img = match h.encoding() {
@@ -278,7 +275,7 @@ impl Dispatcher {
             }
             VisionAlgorithm::StereoOdometry => {
                 let outcome = self.odometries.answer(&self.world, h, pixels, req, &mut push)?;
-                self.unsolved = outcome == Outcome::NoSolution;
+                return Ok(outcome == Outcome::NoSolution);
             }
             VisionAlgorithm::Correlate => {
                 let l = self
@@ -313,7 +310,7 @@ impl Dispatcher {
                 }
             }
         }
-        Ok(())
+        Ok(false)
     }
 }
 

@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use harvey_msgs::{Encoding, FrameHeader, VisionRequest, VisionStatus};
 use harvey_vision::Gray;
-use harvey_vision::odometry::{Motion, OdometryError, OdometryParams, Prior, VisualOdometry};
+use harvey_vision::odometry::{Motion, OdometryError, Prior, VisualOdometry};
 use harvey_world::World;
 
 use crate::odometry_config::OdometryConfig;
@@ -29,7 +29,6 @@ pub enum Outcome {
 struct Running {
     lucas: bool,
     size: [u32; 2],
-    params: OdometryParams,
     vo: VisualOdometry,
 }
 
@@ -77,8 +76,8 @@ impl Odometries {
         if stale {
             let focal = world.camera.focal_for(h.width_px);
             let params = config.params(focal, size, world.camera.height_m, baseline, lucas);
-            let vo = VisualOdometry::new(params.clone());
-            self.running.insert(req.request_id, Running { lucas, size, params, vo });
+            let vo = VisualOdometry::new(params);
+            self.running.insert(req.request_id, Running { lucas, size, vo });
         }
         let run = self.running.get_mut(&req.request_id).ok_or(VisionStatus::BadParameter)?;
         let (outcome, motion, counts) = if start || stale {
@@ -108,7 +107,7 @@ impl Odometries {
         push(motion);
         push(counts);
         self.points.clear();
-        let rig = run.params.rig;
+        let rig = run.vo.params().rig;
         let (lo, hi) = (config.obstacle_min_z_m, config.obstacle_max_z_m);
         // Only points seen from two stops: a single stereo match may be a blunder (an occluding
         // edge matched against what is behind it).

@@ -133,6 +133,11 @@ impl VisualOdometry {
         }
     }
 
+    /// The settings it runs with.
+    pub fn params(&self) -> &OdometryParams {
+        &self.params
+    }
+
     /// The features carried now: their left-image positions and robot-frame points.
     pub fn features(&self) -> impl Iterator<Item = ([f32; 2], [f64; 3])> + '_ {
         self.features.iter().map(|f| (f.at, f.point))
