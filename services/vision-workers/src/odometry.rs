@@ -4,6 +4,7 @@
 
 use std::collections::BTreeMap;
 
+use harvey_geometry::wrap;
 use harvey_msgs::{Encoding, FrameHeader, VisionRequest, VisionStatus};
 use harvey_vision::Gray;
 use harvey_vision::odometry::{Motion, OdometryError, Prior, VisualOdometry};
@@ -94,6 +95,19 @@ impl Odometries {
                     let counts = [n(r.features), n(s.used), n(r.carried), n(r.reacquired), n(r.pruned), e];
                     (Outcome::Solved, motion, counts)
                 }
+                Err(OdometryError::Implausible { report: r, chi2, .. }) => {
+                    tracing::warn!(chi2, used = r.solution.used, "a motion past the reasonableness limit");
+                    let n = |v: usize| v as f32;
+                    let counts = [
+                        n(run.vo.features().count()),
+                        n(r.solution.used),
+                        n(r.carried),
+                        n(r.reacquired),
+                        n(r.pruned),
+                        0.0,
+                    ];
+                    (Outcome::NoSolution, [0.0; 6], counts)
+                }
                 Err(OdometryError::NoSolution { carried, reacquired, left, .. }) => {
                     let n = run.vo.features().count();
                     let counts = [n as f32, left as f32, carried as f32, reacquired as f32, 0.0, 0.0];
@@ -135,7 +149,11 @@ fn prior(config: &OdometryConfig, req: &VisionRequest) -> Result<Prior, VisionSt
     let sd = if given == [0.0; 3] {
         let d = motion.x_m.hypot(motion.y_m);
         let m = config.prior_sd_per_m * d + config.prior_sd_floor_m;
-        [m, m, config.prior_heading_sd_deg.to_radians()]
+        let turn_deg = wrap(motion.heading_rad).abs().to_degrees();
+        let h = config.prior_heading_sd_deg
+            + config.prior_heading_sd_per_deg * turn_deg
+            + config.prior_heading_sd_deg_per_m * d;
+        [m, m, h.to_radians()]
     } else if given.iter().all(|s| s.is_finite() && *s > 0.0) {
         given
     } else {

@@ -31,16 +31,19 @@ pub struct OdometryConfig {
     pub rigidity_sigmas: f64,
     pub rigidity_floor_m: f64,
     pub edit_chi2: f64,
+    pub plausible_chi2: f64,
     pub min_features: u32,
     pub spacing_px: f64,
     pub min_turn: f64,
     pub disparity_sd_px: f64,
     pub position_sd_px: f64,
     /// The prediction's standard deviation when a request gives none: a share of the distance
-    /// travelled plus a floor, and a heading's.
+    /// travelled plus a floor; the heading's a floor, a share of the turn and so much per metre.
     pub prior_sd_per_m: f64,
     pub prior_sd_floor_m: f64,
     pub prior_heading_sd_deg: f64,
+    pub prior_heading_sd_per_deg: f64,
+    pub prior_heading_sd_deg_per_m: f64,
     /// Points between these heights (m above the floor) are obstacles.
     pub obstacle_min_z_m: f64,
     pub obstacle_max_z_m: f64,
@@ -119,6 +122,7 @@ impl OdometryConfig {
         check(&k.key("rigidity_sigmas"), self.rigidity_sigmas, &Range::above(0.0, 20.0, "sd"))?;
         check(&k.key("rigidity_floor_m"), self.rigidity_floor_m, &Range::closed(0.0, 1.0, "m"))?;
         check(&k.key("edit_chi2"), self.edit_chi2, &Range::above(0.0, 1000.0, ""))?;
+        check(&k.key("plausible_chi2"), self.plausible_chi2, &Range::above(0.0, 1e6, ""))?;
         check_int(&k.key("min_features"), self.min_features, 3, 1000, "")?;
         check(&k.key("spacing_px"), self.spacing_px, &Range::closed(0.0, 100.0, "px"))?;
         check(&k.key("min_turn"), self.min_turn, &unit)?;
@@ -127,6 +131,9 @@ impl OdometryConfig {
         check(&k.key("prior_sd_per_m"), self.prior_sd_per_m, &Range::closed(0.0, 1.0, ""))?;
         check(&k.key("prior_sd_floor_m"), self.prior_sd_floor_m, &Range::above(0.0, 1.0, "m"))?;
         check(&k.key("prior_heading_sd_deg"), self.prior_heading_sd_deg, &Range::above(0.0, 45.0, "deg"))?;
+        check(&k.key("prior_heading_sd_per_deg"), self.prior_heading_sd_per_deg, &unit)?;
+        let per_m = Range::closed(0.0, 90.0, "deg/m");
+        check(&k.key("prior_heading_sd_deg_per_m"), self.prior_heading_sd_deg_per_m, &per_m)?;
         check(&k.key("obstacle_min_z_m"), self.obstacle_min_z_m, &Range::closed(0.0, 10.0, "m"))?;
         let above_min = Range::above(self.obstacle_min_z_m, 10.0, "m");
         check(&k.key("obstacle_max_z_m"), self.obstacle_max_z_m, &above_min)?;
@@ -184,6 +191,7 @@ impl OdometryConfig {
             box_sigmas: self.box_sigmas,
             rigidity: Tolerance { sigmas: self.rigidity_sigmas, floor_m: self.rigidity_floor_m },
             edit_chi2: self.edit_chi2,
+            plausible_chi2: self.plausible_chi2,
             min_features: self.min_features as usize,
             spacing_px: self.spacing_px as f32,
             min_turn: self.min_turn,

@@ -9,6 +9,7 @@
 //! (`lucas.rs`), and the features are then reacquired where that motion puts them.
 
 pub mod lucas;
+pub mod magnify;
 pub mod reacquire;
 pub mod rig;
 pub mod rigidity;
@@ -40,6 +41,10 @@ pub struct OdometryParams {
     pub edit_chi2: f64,
     /// No motion is solved on fewer features.
     pub min_features: usize,
+    /// 003's reasonableness limit: a solved motion further from the prediction than this
+    /// (its squared distance in the prediction's standard deviations, a chi-square with three
+    /// degrees of freedom) is a blunder, not a motion: no solution is reported.
+    pub plausible_chi2: f64,
     /// A new feature is taken only this far (pixels) from every carried one.
     pub spacing_px: f32,
     /// A new feature is taken only where its patch's gradients turn: the structure tensor's
@@ -82,6 +87,10 @@ pub enum OdometryError {
         "no motion solution: {reacquired} of {carried} features found again, {left} after pruning and editing, {needed} needed"
     )]
     NoSolution { carried: usize, reacquired: usize, left: usize, needed: usize },
+    #[error(
+        "the motion solved is {chi2:.1} (chi-square) from the prediction, past the reasonableness limit {limit}"
+    )]
+    Implausible { report: Box<StepReport>, chi2: f64, limit: f64 },
     #[error("the stereo pair is {got:?}, the odometry started on {started:?}")]
     SizeChanged { got: [usize; 2], started: [usize; 2] },
 }
@@ -222,6 +231,20 @@ impl VisualOdometry {
                 return Err(self.no_solution(carried, reacquired, e.left));
             }
         };
+        let chi2 = solve::departure(&solution.motion, prior);
+        if chi2.is_nan() || chi2 > p.plausible_chi2 {
+            let report = StepReport {
+                solution,
+                carried,
+                reacquired,
+                pruned: pruned.dropped,
+                error_scale: pruned.scale,
+                features: 0,
+            };
+            let limit = p.plausible_chi2;
+            self.start(left, right)?;
+            return Err(OdometryError::Implausible { report: Box::new(report), chi2, limit });
+        }
         self.top_up(left, right)?;
         Ok(StepReport {
             solution,

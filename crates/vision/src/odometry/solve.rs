@@ -110,6 +110,17 @@ pub fn solve(
     }
 }
 
+/// How far `motion` lies from the prediction: its squared distance in the prediction's standard
+/// deviations (the heading's difference wrapped), a chi-square with three degrees of freedom
+/// while the prediction's margins hold.
+pub fn departure(motion: &Motion, prior: &Prior) -> f64 {
+    let p = &prior.motion;
+    let dh = (motion.heading_rad - p.heading_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+        - std::f64::consts::PI;
+    let d = [motion.x_m - p.x_m, motion.y_m - p.y_m, dh];
+    (0..3).map(|k| (d[k] / prior.sd[k]).powi(2)).sum()
+}
+
 /// Iterates from `motion` to the weighted least-squares motion; returns the normal matrix.
 fn gauss_newton(pairs: &[Pair], active: &[bool], prior: &Prior, motion: &mut Motion) -> [[f64; 3]; 3] {
     let mut h = [[0.0; 3]; 3];
@@ -237,6 +248,10 @@ mod tests {
         assert_eq!(s.edited, 2, "{s:?}");
         assert!(!active[3] && !active[11]);
         assert!((s.motion.x_m - 0.4).abs() < 1e-3 && (s.motion.y_m + 0.05).abs() < 3e-3, "{s:?}");
+
+        // The reasonableness limit's measure: in the prediction's sds, the heading wrapped.
+        let near = Motion { x_m: 0.35 + 0.05, y_m: 0.1, heading_rad: std::f64::consts::TAU };
+        assert!((departure(&near, &prior) - 6.0).abs() < 1e-9, "{}", departure(&near, &prior));
 
         let mut few = vec![false; dirty.len()];
         few[..4].fill(true);

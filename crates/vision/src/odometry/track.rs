@@ -2,7 +2,7 @@
 //! motion puts it and ranged, and new ones taken from the stop's pair where the carried ones are
 //! not (003: reacquisition on the time axis, interest operator and stereo on the stereo axis).
 
-use super::{Feature, OdometryError, Pair, Prior, VisualOdometry, reacquire, select};
+use super::{Feature, OdometryError, Pair, Prior, VisualOdometry, magnify, reacquire, select};
 use crate::image::{Gray, GrayBuf, Rect};
 use crate::nc::Template;
 
@@ -34,16 +34,26 @@ impl VisualOdometry {
             if m.score < p.track_min_score {
                 continue;
             }
-            let (x, y) = (m.x + half, m.y + half);
+            // The match lies off the feature by the view's magnification of its patch.
+            let a = magnify::local_affine(&p.rig, f.at, f.point, &prior.motion);
+            let d = magnify::drift(&f.patch, a);
+            let at = [m.centre[0] - d[0] as f32, m.centre[1] - d[1] as f32];
+            if !(at[0] >= 0.0 && at[1] >= 0.0) {
+                continue;
+            }
+            let (x, y) = (at[0] as usize, at[1] as usize);
+            if x < half || y < half || x + half >= left.width || y + half >= left.height {
+                continue;
+            }
             let Some(s) = self.stereo.match_at(left, right, x, y, &p.stereo)? else { continue };
-            let Some(point) = p.rig.triangulate(m.centre, s.disparity) else { continue };
+            let Some(point) = p.rig.triangulate(at, s.disparity) else { continue };
             self.pairs.push(Pair {
                 old: f.point,
                 new: point,
                 old_cov: p.rig.covariance(f.point),
                 new_cov: p.rig.covariance(point),
             });
-            self.found.push(Feature { point, at: m.centre, patch: patch_at(left, x, y, half)? });
+            self.found.push(Feature { point, at, patch: patch_at(left, x, y, half)? });
         }
         Ok(())
     }

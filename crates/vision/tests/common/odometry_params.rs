@@ -40,6 +40,8 @@ pub fn params(w: &World, width: u32, height: u32, baseline_m: f64, solver: Solve
         rigidity: Tolerance { sigmas: 4.0, floor_m: 0.03 },
         edit_chi2: 13.8,
         min_features: 8,
+        // A chi-square with three degrees of freedom, p = 0.001.
+        plausible_chi2: 16.3,
         spacing_px: 8.0,
         // An edge's patch has a ratio near 0 (a corner's near 1): a tenth keeps corners of two
         // edges of quite different contrast and leaves edges in any direction out.

@@ -132,13 +132,14 @@ pub fn run(w: &World, poses: &[Pose2], seed: u64, solver: Solver) -> Figures {
         };
         let prior = Prior { motion: predicted, sd: [0.05 * d + 0.01, 0.05 * d + 0.01, 2f64.to_radians()] };
         let (l, r) = camera.pair(&w, pair[1], 3.0 * (k + 1) as f64);
-        // A stop without a solution keeps the prediction (the executive would stop and look).
+        // A stop without a solution, or with one past the reasonableness limit, keeps the
+        // prediction (the executive would stop and look).
         let (step, solved) = match vo.step(&gray(&l), &gray(&r), &prior) {
             Ok(report) => {
                 f.fewest_used = f.fewest_used.min(report.solution.used);
                 (report.solution.motion, true)
             }
-            Err(OdometryError::NoSolution { .. }) => {
+            Err(OdometryError::NoSolution { .. } | OdometryError::Implausible { .. }) => {
                 f.failed += 1;
                 (predicted, false)
             }
