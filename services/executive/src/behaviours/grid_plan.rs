@@ -115,6 +115,26 @@ impl Grid {
     }
 }
 
+impl Grid {
+    /// What walking from `from` through `path` costs, in the search's units (a free cell's
+    /// length 1, a margin's 10, a reach's 100), sampled every half cell.
+    pub fn cost(&self, from: [f64; 2], path: &[[f64; 2]]) -> f64 {
+        let mut at = from;
+        let mut sum = 0.0;
+        for p in path {
+            let d = (p[0] - at[0]).hypot(p[1] - at[1]);
+            let n = (2.0 * d / self.cell_m).ceil().max(1.0) as usize;
+            for k in 1..=n {
+                let t = k as f64 / n as f64;
+                let q = [at[0] + t * (p[0] - at[0]), at[1] + t * (p[1] - at[1])];
+                sum += d / n as f64 / self.cell_m * COST[usize::from(self.blocked(q))] as f64;
+            }
+            at = *p;
+        }
+        sum
+    }
+}
+
 /// The point `step_m` along `path` from `from` (the path's end if it is shorter).
 pub fn along(from: [f64; 2], path: &[[f64; 2]], step_m: f64) -> [f64; 2] {
     let mut left = step_m;
@@ -166,5 +186,10 @@ mod tests {
         }
         assert!(pen.path([2.0, 2.0], [0.2, 0.2]).is_some(), "dear, not impassable");
         assert!(g.blocked([9.0, 3.0]) == 2 && g.path([9.0, 3.0], [1.0, 1.0]).is_none(), "outside");
+        // A walk's cost: free cells one a cell, through the margin and the reach dearer.
+        let free = g.cost([1.0, 1.0], &[[7.0, 1.0]]);
+        assert!((free - 60.0).abs() < 1e-9, "{free}");
+        let through = g.cost([1.0, 3.0], &[[7.0, 3.0]]);
+        assert!(through > 60.0 + 9.0 * 2.0 && through > g.cost([1.0, 3.0], &path), "{through}");
     }
 }

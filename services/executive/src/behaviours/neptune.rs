@@ -18,6 +18,11 @@ use crate::mission::NeptuneGoal;
 /// The odometry request's id: the vision workers keep one odometry per id.
 pub const REQUEST_ID: u32 = 3003;
 
+/// The last stop's path is kept while a fresh one would not cost a fifth less: without it, the
+/// path's first cells flipped from one side of an obstacle to the other between stops and the
+/// robot turned to and fro in turn-only steps.
+const KEEP_ROUTE: f64 = 1.25;
+
 /// A turn or a drive taking `s` seconds unhindered is given up after twice that and 3 s more
 /// (the sonar's reflexes hold the robot back while something is near).
 fn allowance(s: f64) -> u64 {
@@ -62,6 +67,8 @@ pub struct Neptune {
     ring: Option<SonarRing>,
     /// Obstacle points seen (world frame, m), each with where it was seen from.
     obstacles: Vec<([f64; 2], [f64; 2])>,
+    /// The path the last step was taken along (world frame, the goal last).
+    route: Vec<[f64; 2]>,
     /// Looks answered, and those whose motion came from the prediction.
     pub stops: u32,
     pub unsolved: u32,
@@ -80,6 +87,7 @@ impl Neptune {
             at: start,
             ring: None,
             obstacles: Vec::new(),
+            route: Vec::new(),
             stops: 0,
             unsolved: 0,
             next_id: 1,
@@ -170,7 +178,7 @@ impl Neptune {
     /// clearance a margin and their hard clearance the robot's reach. Stereo sees an obstacle's
     /// face, not what is behind it: each point also blocks its shadow, `shadow_m` on along the
     /// ray it was seen by (the body of a box seen from the front).
-    fn plan(&self, here: [f64; 2]) -> Option<[f64; 2]> {
+    fn plan(&mut self, here: [f64; 2]) -> Option<[f64; 2]> {
         let g = &self.g;
         let samples = (g.shadow_m / (g.cell_m / 2.0)).ceil().max(1.0) as usize;
         let mut grid = Grid::new(g.room_min_m, g.room_max_m, g.cell_m);
@@ -184,7 +192,16 @@ impl Neptune {
                 grid.block(at, g.hard_clearance_m, 2);
             }
         }
-        grid.path(here, g.goal_m).map(|path| along(here, &path, g.step_m))
+        let fresh = grid.path(here, g.goal_m)?;
+        // The rest of the last path: from its point nearest the robot on.
+        let nearest = (0..self.route.len()).min_by(|&a, &b| {
+            let d = |p: [f64; 2]| (p[0] - here[0]).hypot(p[1] - here[1]);
+            d(self.route[a]).total_cmp(&d(self.route[b]))
+        });
+        let kept = nearest.map(|i| self.route.split_off(i)).unwrap_or_default();
+        let keep = !kept.is_empty() && grid.cost(here, &kept) <= KEEP_ROUTE * grid.cost(here, &fresh);
+        self.route = if keep { kept } else { fresh };
+        Some(along(here, &self.route, g.step_m))
     }
 
     /// One odometry tick: the look to send, the velocity command and the state to publish.

@@ -118,3 +118,29 @@ fn the_goal_ends_it_a_held_step_is_given_up_and_a_walled_in_robot_fails() {
     n.on_vision(&answer(VisionStatus::Found, [0.0; 3], 0.0, &[]));
     assert_eq!(n.done, Some(false));
 }
+
+#[test]
+fn a_path_round_one_side_is_kept_while_the_other_is_not_much_cheaper() {
+    let mut n = Neptune::new(goal(), START);
+    // A post straight ahead on the line to the goal: either side is as good.
+    n.obstacles.push(([3.0, 3.0], [0.8, 3.0]));
+    let first = n.plan([0.8, 3.0]).expect("a path");
+    let side = (n.route[n.route.len() / 3][1] - 3.0).signum();
+    assert!(side != 0.0, "round one side: {:?}", n.route);
+    // A quarter of a metre to the other side of the line: a fresh plan would go round that side
+    // (the robot turned to and fro between stops); the kept one goes on round the first.
+    let other = [1.2, 3.0 - 0.25 * side];
+    let mut fresh = n.clone();
+    fresh.route.clear();
+    fresh.plan(other).expect("a path");
+    assert_eq!((fresh.route[fresh.route.len() / 3][1] - 3.0).signum(), -side, "{:?}", fresh.route);
+    let next = n.plan(other).expect("a path");
+    assert_eq!((n.route[n.route.len() / 3][1] - 3.0).signum(), side, "{:?}", n.route);
+    assert!((next[1] - 3.0) * side >= (first[1] - 3.0) * side - 0.1, "{first:?} then {next:?}");
+    // Once its side is walled off, the kept path is dropped for the other.
+    for k in 0..8 {
+        n.obstacles.push(([3.0, 3.0 + side * 0.1 * f64::from(k)], [1.2, 3.0]));
+    }
+    n.plan(other).expect("a path");
+    assert_eq!((n.route[n.route.len() / 3][1] - 3.0).signum(), -side, "{:?}", n.route);
+}
