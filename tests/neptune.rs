@@ -2,9 +2,9 @@
 //! goal in stop-go-stop steps, the position model from stereo alone, the path planned round the
 //! obstacles stereo ranged. Judged from the recording against the simulator's truth: the goal is
 //! reached and nothing in the room is ever touched; the model ends within 0.25 m of the truth
-//! (the paper: under half a metre) and no step is off by 0.25 m (the paper: drastic errors near
-//! a metre). Issue 18's bars (0.10 m at the end, 0.05 m a step) are not met on every seed:
-//! `docs/evaluation.md` has the sweep.
+//! (the paper: under half a metre) and no step is off by 0.15 m (the paper: drastic errors near
+//! a metre; over 20 seeds the worst step was 0.124 m, under harsh). Issue 18's bars (0.10 m at
+//! the end, 0.05 m a step) are not met on every seed: `docs/evaluation.md` has the sweep.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
@@ -94,7 +94,7 @@ fn check(condition: &str, seeds: std::ops::RangeInclusive<u64>) {
         println!("{condition} s{seed}: {f:?}");
         assert!(f.final_error_m < 0.25, "{condition} s{seed}: the model ends {:.3} m off", f.final_error_m);
         assert!(f.from_goal_m < 0.35, "{condition} s{seed}: {:.3} m from the goal", f.from_goal_m);
-        assert!(f.worst_step_m < 0.25, "{condition} s{seed}: a step off by {:.3} m", f.worst_step_m);
+        assert!(f.worst_step_m < 0.15, "{condition} s{seed}: a step off by {:.3} m", f.worst_step_m);
         assert!(f.clearance_m > 0.0, "{condition} s{seed}: touched something ({:.3} m)", f.clearance_m);
         assert!(f.stops >= 16, "{condition} s{seed}: {} stops for 6.4 m of 0.4 m steps", f.stops);
         // Most stops are solved by stereo; those that are not are dead reckoned and counted.
