@@ -161,3 +161,44 @@ fn prior(config: &OdometryConfig, req: &VisionRequest) -> Result<Prior, VisionSt
     };
     Ok(Prior { motion, sd })
 }
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
+    use super::*;
+    use harvey_msgs::Pose2;
+
+    fn config() -> OdometryConfig {
+        let path = format!("{}/../../missions/odometry/003.toml", env!("CARGO_MANIFEST_DIR"));
+        OdometryConfig::load(std::path::Path::new(&path)).expect("loads")
+    }
+
+    fn request(x_m: f64, y_m: f64, heading_deg: f64, sd: [f32; 3]) -> VisionRequest {
+        let mut params = [0.0f32; 8];
+        params[2..5].copy_from_slice(&sd);
+        let expected = Pose2 { x_m, y_m, heading_rad: heading_deg.to_radians() };
+        VisionRequest { expected, params, ..VisionRequest::default() }
+    }
+
+    #[test]
+    fn the_prediction_s_margins_follow_its_travel_and_turn() {
+        let c = config();
+        let deg = |p: &Prior| p.sd[2].to_degrees();
+        // A 13-degree turn in place: 0.5 + 3 % of 13 degrees; 1 cm either way.
+        let turn = prior(&c, &request(0.0, 0.0, 13.0, [0.0; 3])).expect("a prior");
+        assert!((deg(&turn) - 0.89).abs() < 1e-9 && (turn.sd[0] - 0.01).abs() < 1e-12, "{turn:?}");
+        // A heading given past a turn counts as the turn it is (350 degrees: 10 to the right),
+        // and 0.4 m of travel adds 1.3 degrees a metre and 5 % of the distance.
+        let step = prior(&c, &request(0.4, 0.0, 350.0, [0.0; 3])).expect("a prior");
+        assert!((deg(&step) - (0.5 + 0.3 + 0.52)).abs() < 1e-9, "{step:?}");
+        assert!((step.sd[1] - 0.03).abs() < 1e-12, "{step:?}");
+        // Margins the request gives are taken as they are; bad ones are refused.
+        let given = prior(&c, &request(0.4, 0.0, 0.0, [0.02, 0.03, 0.01])).expect("a prior");
+        assert_eq!(given.sd, [0.02f32, 0.03, 0.01].map(f64::from));
+        assert_eq!(
+            prior(&c, &request(0.4, 0.0, 0.0, [0.02, -1.0, 0.01])).err(),
+            Some(VisionStatus::BadParameter)
+        );
+        assert_eq!(prior(&c, &request(f64::NAN, 0.0, 0.0, [0.0; 3])).err(), Some(VisionStatus::BadParameter));
+    }
+}

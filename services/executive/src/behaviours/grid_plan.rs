@@ -11,6 +11,11 @@ use std::collections::BinaryHeap;
 /// What a step into a cell costs, by how it is blocked (free, in a margin, within reach).
 const COST: [u64; 3] = [1, 10, 100];
 
+/// The last stop's path is kept while a fresh one would not cost a fifth less (a stated value):
+/// without it, the path's first cells flipped from one side of an obstacle to the other between
+/// stops and the robot turned to and fro in turn-only steps.
+const KEEP_ROUTE: f64 = 1.25;
+
 /// The grid: the room's extent, the cell side, how each cell is blocked (0 free, 1 a margin, 2
 /// within reach).
 #[derive(Debug, Clone)]
@@ -133,6 +138,23 @@ impl Grid {
         }
         sum
     }
+}
+
+/// The rest of the last stop's `route` (from its point nearest `here` on) while walking it costs
+/// at most `KEEP_ROUTE` times the `fresh` path; else the fresh path.
+pub fn kept_or_fresh(
+    grid: &Grid,
+    here: [f64; 2],
+    mut route: Vec<[f64; 2]>,
+    fresh: Vec<[f64; 2]>,
+) -> Vec<[f64; 2]> {
+    let nearest = (0..route.len()).min_by(|&a, &b| {
+        let d = |p: [f64; 2]| (p[0] - here[0]).hypot(p[1] - here[1]);
+        d(route[a]).total_cmp(&d(route[b]))
+    });
+    let kept = nearest.map(|i| route.split_off(i)).unwrap_or_default();
+    let keep = !kept.is_empty() && grid.cost(here, &kept) <= KEEP_ROUTE * grid.cost(here, &fresh);
+    if keep { kept } else { fresh }
 }
 
 /// The point `step_m` along `path` from `from` (the path's end if it is shorter).

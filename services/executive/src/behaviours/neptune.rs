@@ -12,16 +12,11 @@ use harvey_msgs::{
 };
 
 use super::drive;
-use super::grid_plan::{Grid, along};
+use super::grid_plan::{Grid, along, kept_or_fresh};
 use crate::mission::NeptuneGoal;
 
 /// The odometry request's id: the vision workers keep one odometry per id.
 pub const REQUEST_ID: u32 = 3003;
-
-/// The last stop's path is kept while a fresh one would not cost a fifth less: without it, the
-/// path's first cells flipped from one side of an obstacle to the other between stops and the
-/// robot turned to and fro in turn-only steps.
-const KEEP_ROUTE: f64 = 1.25;
 
 /// A turn or a drive taking `s` seconds unhindered is given up after twice that and 3 s more
 /// (the sonar's reflexes hold the robot back while something is near).
@@ -174,7 +169,8 @@ impl Neptune {
         self.phase = Phase::Turning { to: odo_from_world.apply(target), deadline_ns: 0, then_move };
     }
 
-    /// The end of the next step: `step_m` along the cheapest path round the obstacles, their
+    /// The end of the next step: `step_m` along the cheapest path round the obstacles (or the
+    /// last stop's, while not much dearer: `kept_or_fresh`), their
     /// clearance a margin and their hard clearance the robot's reach. Stereo sees an obstacle's
     /// face, not what is behind it: each point also blocks its shadow, `shadow_m` on along the
     /// ray it was seen by (the body of a box seen from the front).
@@ -193,14 +189,7 @@ impl Neptune {
             }
         }
         let fresh = grid.path(here, g.goal_m)?;
-        // The rest of the last path: from its point nearest the robot on.
-        let nearest = (0..self.route.len()).min_by(|&a, &b| {
-            let d = |p: [f64; 2]| (p[0] - here[0]).hypot(p[1] - here[1]);
-            d(self.route[a]).total_cmp(&d(self.route[b]))
-        });
-        let kept = nearest.map(|i| self.route.split_off(i)).unwrap_or_default();
-        let keep = !kept.is_empty() && grid.cost(here, &kept) <= KEEP_ROUTE * grid.cost(here, &fresh);
-        self.route = if keep { kept } else { fresh };
+        self.route = kept_or_fresh(&grid, here, std::mem::take(&mut self.route), fresh);
         Some(along(here, &self.route, g.step_m))
     }
 
