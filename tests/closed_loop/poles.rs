@@ -12,7 +12,7 @@ fn parked(rig: &Rig) -> usize {
     match &rig.exec.mode {
         Mode::Sequenced(run) => match &run.behaviour {
             Behaviour::Poles(h) => h.visited.len(),
-            Behaviour::Docking(_) | Behaviour::Neptune(_) => 0,
+            _ => 0,
         },
         _ => 0,
     }

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use harvey_world::{World, WorldError};
 
 use crate::behaviours::docking::Docking;
+use crate::behaviours::door_finding::DoorFinding;
 use crate::behaviours::fsa::{Fsa, FsaError};
 use crate::behaviours::neptune::Neptune;
 use crate::behaviours::pole_hunt::PoleHunt;
@@ -240,12 +241,17 @@ impl Site<'_> {
     }
 
     /// The docking behaviour or the pole hunt (the acceptor, the camera, the sonar, the seed),
-    /// or CMU's navigation (its start).
+    /// CMU's navigation (its start), or door finding (the sonar ring's radius, the start).
     fn behaviour(&self, seed: u64) -> Result<Option<Behaviour>, SetupError> {
         let m = self.mission;
         if let Some(g) = &m.neptune {
             let start = self.world("[mission.neptune]")?.start;
             return Ok(Some(Behaviour::Neptune(Box::new(Neptune::new(g.clone(), start)))));
+        }
+        if let Some(g) = &m.door {
+            let w = self.world("[mission.door]")?;
+            let d = DoorFinding::new(g.clone(), w.robot.sonar_ring_radius_m, w.start);
+            return Ok(Some(Behaviour::Door(Box::new(d))));
         }
         let key = match (&m.docking, &m.poles) {
             (Some(_), _) => "[mission.docking]",

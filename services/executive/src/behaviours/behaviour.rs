@@ -1,5 +1,6 @@
 //! The acceptor-sequenced behaviours a mission may run instead of a script or a plan (004):
-//! docking and the pole hunt, and CMU's stop-go-stop navigation (003), behind one face, and
+//! docking and the pole hunt, CMU's stop-go-stop navigation (003) and door finding by sonar
+//! (001 §3.2), behind one face, and
 //! run as the executive's mode.
 
 use harvey_msgs::{
@@ -8,6 +9,7 @@ use harvey_msgs::{
 };
 
 use super::docking::Docking;
+use super::door_finding::DoorFinding;
 use super::neptune::Neptune;
 use super::pole_hunt::PoleHunt;
 use crate::{Output, Progress};
@@ -17,6 +19,7 @@ pub enum Behaviour {
     Docking(Box<Docking>),
     Poles(Box<PoleHunt>),
     Neptune(Box<Neptune>),
+    Door(Box<DoorFinding>),
 }
 
 impl Behaviour {
@@ -25,6 +28,7 @@ impl Behaviour {
             Self::Docking(d) => d.on_sonar(r),
             Self::Poles(p) => p.on_sonar(r),
             Self::Neptune(n) => n.on_sonar(r),
+            Self::Door(d) => d.on_sonar(r),
         }
     }
 
@@ -40,6 +44,7 @@ impl Behaviour {
             Self::Docking(d) => d.on_vision(r),
             Self::Poles(p) => p.on_vision(r),
             Self::Neptune(n) => n.on_vision(r),
+            Self::Door(_) => {}
         }
     }
 
@@ -53,6 +58,10 @@ impl Behaviour {
             Self::Docking(d) => d.on_odometry(odometry, now),
             Self::Poles(p) => p.on_odometry(odometry, now),
             Self::Neptune(n) => n.on_odometry(odometry, now),
+            Self::Door(d) => {
+                let (command, state) = d.on_odometry(odometry, now);
+                (None, command, state)
+            }
         }
     }
 
@@ -62,13 +71,14 @@ impl Behaviour {
             Self::Docking(d) => d.done,
             Self::Poles(p) => p.done,
             Self::Neptune(n) => n.done,
+            Self::Door(d) => d.done,
         }
     }
 
     /// Whether the mission counts as succeeded if its time runs out now.
     pub fn enough_at_timeout(&self) -> bool {
         match self {
-            Self::Docking(_) | Self::Neptune(_) => false,
+            Self::Docking(_) | Self::Neptune(_) | Self::Door(_) => false,
             Self::Poles(p) => p.enough(),
         }
     }
@@ -78,7 +88,7 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.believed(),
             Self::Neptune(n) => n.believed(),
-            Self::Poles(_) => odometry,
+            Self::Poles(_) | Self::Door(_) => odometry,
         }
     }
 
@@ -87,6 +97,7 @@ impl Behaviour {
             Self::Docking(d) => d.goal_pose(),
             Self::Poles(p) => p.goal_pose(),
             Self::Neptune(n) => n.goal_pose(),
+            Self::Door(d) => d.goal_pose(),
         }
     }
 }

@@ -4,18 +4,26 @@
 //! Docking (`docking.rs`, the pose from the dock in `dock_pose.rs`, judged by the UMS's region in
 //! `region.rs`) and the pole hunt
 //! (`pole_hunt.rs`) behind one face (`behaviour.rs`), with CMU's stop-go-stop navigation by
-//! stereo (003, `neptune.rs`, its path round the obstacles seen in `grid_plan.rs`).
+//! stereo (003, `neptune.rs`, its path round the obstacles seen in `grid_plan.rs`), and door
+//! finding by sonar alone (001 §3.2, `door_finding.rs`: the wall followed in `wall.rs`, its
+//! openings told in `opening.rs`, the schema-based way in `door_schemas.rs`).
 
 pub mod behaviour;
 pub mod dock_pose;
 pub mod docking;
+pub mod door_finding;
+mod door_follow;
+mod door_locate;
+mod door_schemas;
 pub mod drive;
 pub mod fsa;
 pub mod grid_plan;
 pub mod neptune;
+pub mod opening;
 pub mod pole_hunt;
 pub mod region;
 pub mod schemas;
 pub mod sequenced;
+pub mod wall;
 
 pub use behaviour::{Behaviour, Run};

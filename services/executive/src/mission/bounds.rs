@@ -87,6 +87,9 @@ pub(crate) fn check_bounds(m: &Mission) -> Result<(), OutOfRange> {
     if let Some(n) = &m.neptune {
         super::bounds_goals::check_neptune(&root("neptune"), n)?;
     }
+    if let Some(d) = &m.door {
+        super::door::check_bounds(&root("door"), d)?;
+    }
     Ok(())
 }
 

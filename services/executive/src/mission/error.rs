@@ -18,12 +18,13 @@ pub enum MissionError {
     #[error("{file}: mission.timeout_s must be positive")]
     Timeout { file: String },
     #[error(
-        "{file}: the mission has no [[mission.step]], [mission.ptrans], [mission.docking] or [mission.poles]"
+        "{file}: the mission has no [[mission.step]], [mission.ptrans], [mission.docking], [mission.poles], \
+         [mission.neptune] or [mission.door]"
     )]
     NothingToDo { file: String },
     #[error(
-        "{file}: [mission.ptrans], [mission.docking] and [mission.poles] make their own steps: one of \
-         them, and no [[mission.step]]"
+        "{file}: [mission.ptrans], [mission.docking], [mission.poles], [mission.neptune] and [mission.door] \
+         make their own steps: one of them, and no [[mission.step]]"
     )]
     TooMuchToDo { file: String },
     /// A goal table (`ptrans`, `docking` or `poles`) whose values do not make sense.

@@ -8,9 +8,11 @@ use serde::Deserialize;
 
 mod bounds;
 mod bounds_goals;
+pub mod door;
 mod error;
 pub mod goals;
 
+pub use door::{DoorGoal, DoorVariant, Side};
 pub use error::MissionError;
 pub use goals::{DockingGoal, NeptuneGoal, PolesGoal, PtransGoal};
 use goals::{check_docking, check_neptune, check_poles, check_ptrans};
@@ -108,6 +110,7 @@ pub struct Mission {
     pub docking: Option<DockingGoal>,
     pub poles: Option<PolesGoal>,
     pub neptune: Option<NeptuneGoal>,
+    pub door: Option<DoorGoal>,
 }
 
 #[derive(Deserialize)]
@@ -139,7 +142,8 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
     let behaviours = usize::from(m.ptrans.is_some())
         + usize::from(m.docking.is_some())
         + usize::from(m.poles.is_some())
-        + usize::from(m.neptune.is_some());
+        + usize::from(m.neptune.is_some())
+        + usize::from(m.door.is_some());
     match (behaviours, m.steps.is_empty()) {
         (0, true) => return Err(MissionError::NothingToDo { file: file_name() }),
         (1, true) | (0, false) => {}
@@ -157,6 +161,9 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
     }
     if let Some(n) = &m.neptune {
         check_neptune(n).map_err(|what| goal("neptune", what))?;
+    }
+    if let Some(d) = &m.door {
+        door::check_door(d).map_err(|what| goal("door", what))?;
     }
     for (index, s) in m.steps.iter().enumerate() {
         match (s.move_m, s.turn_deg, s.refine_pose) {
