@@ -122,20 +122,6 @@ fn sweep(mission: &str, tag: &str, bars: &Bars) {
     assert!(misses.is_empty(), "{mission}: {misses:?}");
 }
 
-/// `harvey replay --check` of a run of `mission`: every message comes back (as processes, or
-/// `--in-process`).
-fn replays(mission: &str, tag: &str, how: &[&str]) {
-    let out = common::run_mission(mission, tag);
-    assert!(out.status.success() && out.stdout.contains("goal reached"), "{}", out.stdout);
-    let (replay, _, dir) = common::replay_check_with(&out.dir.join("run.mcap"), tag, how);
-    let said = String::from_utf8_lossy(&replay.stdout);
-    assert_eq!(replay.status.code(), Some(0), "{said}\n{}", String::from_utf8_lossy(&replay.stderr));
-    let summary = mcap::Summary::read(&out.mcap).expect("summary").expect("present");
-    let count = summary.stats.expect("stats").message_count as usize;
-    assert_eq!(common::agreed(&replay), Some(count), "{said}");
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
 // A 0.9 m doorway leaves a 0.46 m robot 0.22 m a side. Following the wall puts it through the
 // middle (over seeds 1..40 the worst crossing was 0.068 m off, the nearest jamb 0.152 m away);
 // the schemas come in at a slant, carried along the wall until the press wins, so they cross
@@ -153,10 +139,10 @@ fn motor_schemas_find_the_doorway_and_go_through_on_every_seed() {
 
 #[test]
 fn a_door_finding_run_replays_identically_as_processes() {
-    replays("missions/door-finding.toml", "doorrp", &[]);
+    common::assert_replays("missions/door-finding.toml", "doorrp", &[]);
 }
 
 #[test]
 fn a_schemas_door_finding_run_replays_identically_in_process() {
-    replays("missions/door-finding-schemas.toml", "doorri", &["--in-process"]);
+    common::assert_replays("missions/door-finding-schemas.toml", "doorri", &["--in-process"]);
 }

@@ -249,6 +249,21 @@ pub fn replay_check_with(
     (out, prefix, dir)
 }
 
+/// Runs `mission` in process to its goal and holds `harvey replay --check` of its recording (as
+/// processes, or with `how` = `--in-process`) to every message of it.
+#[allow(dead_code)]
+pub fn assert_replays(mission: &str, tag: &str, how: &[&str]) {
+    let out = run_mission(mission, tag);
+    assert!(out.status.success() && out.stdout.contains("goal reached"), "{}", out.stdout);
+    let (replay, _, dir) = replay_check_with(&out.dir.join("run.mcap"), tag, how);
+    let said = String::from_utf8_lossy(&replay.stdout);
+    assert_eq!(replay.status.code(), Some(0), "{said}\n{}", String::from_utf8_lossy(&replay.stderr));
+    let summary = mcap::Summary::read(&out.mcap).expect("summary").expect("present");
+    let count = summary.stats.expect("stats").message_count as usize;
+    assert_eq!(agreed(&replay), Some(count), "{said}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// How many messages a `--check` or `harvey diff` found identical (its `identical: N` line).
 #[allow(dead_code)]
 pub fn agreed(out: &std::process::Output) -> Option<usize> {

@@ -13,8 +13,12 @@ const LIGHT_STREAM: u64 = 0x6c69_6768_7473;
 const MOUNT_STREAM: u64 = 0x006d_6f75_6e74;
 
 /// The camera mount's true yaw (left positive) and pitch (down positive) for a run of `seed`,
-/// radians: each a normal draw of the world's `misalignment_sd_rad`, unknown to the robot.
+/// radians: the world's `mount_error_rad` when it gives one, else each a normal draw of its
+/// `misalignment_sd_rad`; unknown to the robot.
 pub fn mount_error(c: &Camera, seed: u64) -> (f64, f64) {
+    if let Some([yaw, pitch]) = c.mount_error_rad {
+        return (yaw, pitch);
+    }
     if c.misalignment_sd_rad == 0.0 {
         return (0.0, 0.0);
     }
@@ -132,6 +136,21 @@ mod tests {
         let n = px.len() as f64;
         let mean = px.iter().map(|&p| f64::from(p)).sum::<f64>() / n;
         (mean, (px.iter().map(|&p| (f64::from(p) - mean).powi(2)).sum::<f64>() / n).sqrt())
+    }
+
+    #[test]
+    fn a_mount_error_given_is_taken_exactly_and_a_spread_is_drawn_per_seed() {
+        let w =
+            harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("world");
+        let mut c = w.camera.clone();
+        let (a, b) = (mount_error(&c, 1), mount_error(&c, 2));
+        assert!(a != b && a.0.abs() < 0.02 && a.1.abs() < 0.02, "{a:?} {b:?}");
+        assert_eq!(mount_error(&c, 1), a, "seeded");
+        c.mount_error_rad = Some([0.01, -0.002]);
+        assert_eq!((mount_error(&c, 1), mount_error(&c, 2)), ((0.01, -0.002), (0.01, -0.002)));
+        c.mount_error_rad = None;
+        c.misalignment_sd_rad = 0.0;
+        assert_eq!(mount_error(&c, 1), (0.0, 0.0));
     }
 
     #[test]

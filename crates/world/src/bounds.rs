@@ -107,6 +107,10 @@ fn check_camera(w: &World) -> Result<(), OutOfRange> {
     check(&k.key("illumination_period_s"), c.illumination_period_s, &Range::above(0.0, 1e6, "s"))?;
     // 000 §5.5 studies 0.001 and 0.010 rad; 0.2 rad (11 degrees) is a camera knocked off its mount.
     check(&k.key("misalignment_sd_rad"), c.misalignment_sd_rad, &Range::closed(0.0, 0.2, "rad"))?;
+    if let Some([yaw, pitch]) = c.mount_error_rad {
+        check(&k.key("mount_error_rad[0]"), yaw, &Range::within(0.2, "rad"))?;
+        check(&k.key("mount_error_rad[1]"), pitch, &Range::within(0.2, "rad"))?;
+    }
     check(&k.key("blur_px"), f64::from(c.blur_px), &Range::closed(0.0, 16.0, "px"))?;
     // 003's rover: 25 cm; a rig wider than the robot (2 m) is a typing mistake.
     match c.stereo_baseline_m {
