@@ -9,6 +9,7 @@
 //! a threshold lowered in a dim window: the same edge counts in a dim frame, a vignetted corner
 //! or under a passing cloud as in a bright one.
 
+pub mod point;
 mod profile;
 
 use harvey_msgs::{Expectation, FrameHeader, Header, LandmarkSighting, SightingKind};
@@ -54,6 +55,12 @@ impl LineLandmarks {
 
     pub fn number_from(&mut self, seq: u64) {
         self.seq = seq;
+    }
+
+    /// Numbers a sighting another recogniser made (one numbering on `vision/sightings`).
+    pub fn number(&mut self, s: &mut LandmarkSighting) {
+        self.seq += 1;
+        s.header.seq = self.seq;
     }
 
     pub fn new(focal_px: f64, threshold: f32) -> Self {

@@ -7,6 +7,7 @@ use clap::Parser;
 use crate::VerticalEdges;
 use crate::dispatch::Dispatcher;
 use crate::landmarks::LineLandmarks;
+use crate::landmarks::point::PointLandmarks;
 use crate::odometry_config::OdometryConfig;
 use harvey_msgs::{
     Detections, Expectation, LandmarkSighting, VisionAlgorithm, VisionRequest, VisionResult, topics,
@@ -28,6 +29,10 @@ pub struct Args {
     /// Look for the landmarks the Expecter asks for (`false`: dead reckoning only, 002 Fig. 79).
     #[arg(long, default_value_t = true, action = clap::ArgAction::Set)]
     pub landmarks: bool,
+    /// Look for class II landmarks too (signs: a point of known height, its bearing and range,
+    /// 002 §3.4), not only class I (`false`: class I only, as the missions that predate it).
+    #[arg(long, default_value_t = false, action = clap::ArgAction::Set)]
+    pub point_landmarks: bool,
     /// Expectations older than this (message time) are not searched for.
     #[arg(long, default_value_t = 300)]
     pub expectation_max_age_ms: u64,
@@ -87,6 +92,8 @@ pub struct Workers {
     dispatcher: Dispatcher,
     edges: VerticalEdges,
     lines: LineLandmarks,
+    /// The class II recogniser, when asked for (`--point-landmarks`).
+    points: Option<PointLandmarks>,
     new_expectations: Vec<Expectation>,
     new_requests: Vec<VisionRequest>,
     processed: u64,
@@ -139,7 +146,17 @@ impl Node for Workers {
             self.lines.focal_px = self.camera.focal_for(h.width_px);
             kept.wanted.retain(|_, e| e.header.stamp_ns + self.max_age_ns >= h.stamp_ns);
             for e in kept.wanted.values().filter(|_| self.landmarks) {
-                if let Some(s) = self.lines.recognise(&h, pixels, e) {
+                let point = match (&mut self.points, e.class) {
+                    (Some(points), 2) => {
+                        points.focal_px = self.lines.focal_px;
+                        points.recognise(&h, pixels, e).map(|mut s| {
+                            self.lines.number(&mut s);
+                            s
+                        })
+                    }
+                    _ => None,
+                };
+                if let Some(s) = point.or_else(|| self.lines.recognise(&h, pixels, e)) {
                     self.found += u64::from(s.kind != 0);
                     io.send(self.sightings, &s)?;
                 }
@@ -204,6 +221,7 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<Workers> {
         lines: LineLandmarks::new(world.camera.focal_px, args.edge_threshold)
             .with_calibration_sd(world.survey.calibration_sd_rad)
             .with_blur(world.camera.blur_px),
+        points: args.point_landmarks.then(|| PointLandmarks::new(&world, world.survey.calibration_sd_rad)),
         dispatcher: Dispatcher::new(world.clone()).with_odometry(odometry),
         camera: world.camera,
         new_expectations: Vec::new(),
