@@ -5,8 +5,9 @@
 //! bearing and range are judged against the truth. Counted: right (bearing and range each within
 //! three of their own standard deviations, which take in the mount's calibration: 1.8 px), wrong
 //! (blunders among them: past five deviations, another thing taken for the sign) and silent; in
-//! windows beside the sign (the sign outside), any answer but "not found" or silence is a
-//! blunder. Prints the table `docs/evaluation.md` quotes.
+//! windows beside the sign (moved 120 px off: the sign outside even once the recogniser pads the
+//! window by the sign's size, but for a sign seen close) nothing else may be taken for it.
+//! Prints the table `docs/evaluation.md` quotes.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use harvey_msgs::{Encoding, Expectation, FrameHeader, Pose2, SightingKind};
@@ -98,11 +99,11 @@ fn tally(condition: (&str, f64, f64, f64, u32), seed: u64, half_px: f64, shift_p
                     let off_px = (seen_u - u).abs();
                     (t.worst_z, t.worst_px) = (t.worst_z.max(z), t.worst_px.max(off_px));
                     let zb = off_px / (s.a_sd * w.camera.focal_px);
-                    if zb <= 3.0 && z <= 3.0 && shift_px == 0.0 {
+                    if zb <= 3.0 && z <= 3.0 {
                         t.right += 1;
                     } else {
                         t.wrong += 1;
-                        t.blunders += usize::from(zb > 5.0 || z > 5.0 || shift_px != 0.0);
+                        t.blunders += usize::from(zb > 5.0 || z > 5.0);
                     }
                 }
             }
@@ -119,7 +120,7 @@ fn the_signs_are_ranged_by_their_rows_whatever_the_light() {
     println!("|---|---|---:|---:|---:|---:|---:|---:|");
     for c in CONDITIONS {
         // Centred, narrow and wide; then beside the sign, the sign outside the window.
-        for (half, shift, what) in [(30.0, 0.0, "±30 px"), (60.0, 0.0, "±60 px"), (30.0, 70.0, "beside")] {
+        for (half, shift, what) in [(30.0, 0.0, "±30 px"), (60.0, 0.0, "±60 px"), (30.0, 120.0, "beside")] {
             let mut all = Tally::default();
             for seed in [1, 2] {
                 let t = tally(c, seed, half, shift);

@@ -85,8 +85,10 @@ pub struct PointLandmarks {
     points: Vec<Option<Point>>,
     frs: Frs,
     pub focal_px: f64,
-    /// The spread of a sign's centroid (pixels), the mount's calibration included.
-    sd_px: f64,
+    /// The spread of a sign's centre (pixels), the mount's calibration included: across, where
+    /// it is four times the box's middle (its edges known to half a pixel) less three times the
+    /// centroid, a pixel; down, the centroid's row, half a pixel.
+    sd_px: [f64; 2],
 }
 
 impl PointLandmarks {
@@ -97,7 +99,7 @@ impl PointLandmarks {
             points: Point::of(world),
             frs: Frs::default(),
             focal_px: f,
-            sd_px: 0.5f64.hypot(f * calibration_sd_rad),
+            sd_px: [1.0f64.hypot(f * calibration_sd_rad), 0.5f64.hypot(f * calibration_sd_rad)],
         }
     }
 
@@ -111,8 +113,26 @@ impl PointLandmarks {
             return None;
         }
         let img = Gray::new(pixels, w, ht, h.stride_bytes as usize).ok()?;
-        let [u0, v0, u1, v1] = e.window_px.map(|x| x.max(0.0) as usize);
-        let win = Rect::new(u0, v0, u1.min(w), v1.min(ht)).inside(w, ht).ok()?;
+        // The window bounds where the point may be; the sign stands round it, by its size at
+        // the depth the window's middle row gives, and the unknown mount moves it by up to three
+        // of its deviations.
+        let [u0, v0, u1, v1] = e.window_px.map(f64::from);
+        let (cx, cy, f) = (w as f64 / 2.0, ht as f64 / 2.0, self.focal_px);
+        let mid_depth = f * point.above_camera_m / (cy - (v0 + v1) / 2.0);
+        let (pad_u, pad_v) = if mid_depth > 0.0 {
+            let half = |size: f64| f * size / mid_depth / 2.0;
+            (
+                half(point.region_width_m) + 3.0 * self.sd_px[0],
+                half(point.region_height_m) + 3.0 * self.sd_px[1],
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let clip = |x: f64, max: usize| x.clamp(0.0, max as f64) as usize;
+        let win =
+            Rect::new(clip(u0 - pad_u, w), clip(v0 - pad_v, ht), clip(u1 + pad_u, w), clip(v1 + pad_v, ht))
+                .inside(w, ht)
+                .ok()?;
         let background = f32::from(percentile(&histogram(&img, win), 0.5));
         let noise = NOISE_SIGMAS * noise_sigma(&img, win);
         let expected = background * point.contrast as f32;
@@ -129,7 +149,6 @@ impl PointLandmarks {
             landmark_index: e.landmark_index,
             ..Default::default()
         };
-        let (cx, cy, f) = (w as f64 / 2.0, ht as f64 / 2.0, self.focal_px);
         let regions = self.frs.segment(&img, win, &[band], MIN_AREA).ok()?;
         let fits: Vec<(f64, f64)> = regions
             .iter()
@@ -157,8 +176,17 @@ impl PointLandmarks {
                 let sized = seen < tall * SIZE_SLACK + 1.0
                     && seen > tall / SIZE_SLACK - 1.0
                     && across < wide * SIZE_SLACK + 1.0;
-                let near = depth > 0.0 && depth < point.max_range_m;
-                (near && solid && sized).then_some((u, v))
+                // Not beyond its activation range: its row at least as far from the horizon as
+                // the sign's at that range, less three of the row's deviations (an unknown pitch
+                // moves a far sign's row by pixels).
+                let off_horizon = (cy - v) * point.above_camera_m.signum();
+                let least = f * point.above_camera_m.abs() / point.max_range_m - 3.0 * self.sd_px[1];
+                let near = depth > 0.0 && off_horizon >= least.max(0.0);
+                // The window was padded for the sign's extent; its centre lies in the window as
+                // given, give or take the mount.
+                let (mu, mv) = (3.0 * self.sd_px[0], 3.0 * self.sd_px[1]);
+                let centred = (u0 - mu..=u1 + mu).contains(&u) && (v0 - mv..=v1 + mv).contains(&v);
+                (near && solid && sized && centred).then_some((u, v))
             })
             .collect();
         let [(u, v)] = fits.as_slice() else {
@@ -170,11 +198,11 @@ impl PointLandmarks {
         let depth = f * point.above_camera_m / (cy - v);
         let range = depth / bearing.cos();
         let range_sd =
-            range * (self.sd_px / (cy - v).abs()).hypot(point.height_sd_m / point.above_camera_m.abs());
+            range * (self.sd_px[1] / (cy - v).abs()).hypot(point.height_sd_m / point.above_camera_m.abs());
         Some(LandmarkSighting {
             kind: SightingKind::BearingRange as u32,
             a: bearing,
-            a_sd: self.sd_px / f,
+            a_sd: self.sd_px[0] / f,
             b: range,
             b_sd: range_sd,
             ..base
