@@ -6,7 +6,8 @@
 //! the truth on some seeds (docs/evaluation.md): not yet an invariant there. With the signs
 //! ranged too (class II, `missions/uncertainty-signs.toml`) the map is smaller again, and loses
 //! the truth no more often than with the bearings alone (ideal, nominal, dim; not harsh, whose
-//! mount is three times worse than the robot's survey says: docs/evaluation.md).
+//! mount is three times worse than the robot's survey says: docs/evaluation.md); with the
+//! baseboard too (class III, `missions/uncertainty-all-classes.toml`) smaller again, likewise.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
@@ -20,11 +21,13 @@ fn run(mission: &str, tag: &str) -> Vec<UncertaintyMap> {
     r.maps
 }
 
-/// A run's maps, the stamps of those the truth lay outside, its class II sightings counted.
+/// A run's maps, the stamps of those the truth lay outside, its class II and III sightings
+/// counted.
 struct Maps {
     maps: Vec<UncertaintyMap>,
     outside: Vec<u64>,
     ranged: usize,
+    lines: usize,
 }
 
 /// Runs a mission under `condition` at `seed`.
@@ -37,7 +40,7 @@ fn run_under(mission: &str, condition: &str, seed: u64, tag: &str) -> Maps {
         out.stderr
     );
     let bytes = out.mcap.as_slice();
-    let (mut maps, mut truth, mut ranged) = (Vec::new(), Vec::new(), 0);
+    let (mut maps, mut truth, mut ranged, mut lines) = (Vec::new(), Vec::new(), 0, 0);
     for m in mcap::MessageStream::new(bytes).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
@@ -46,6 +49,7 @@ fn run_under(mission: &str, condition: &str, seed: u64, tag: &str) -> Maps {
             "/vision/sightings" => {
                 let s = harvey_cdr::decode::<LandmarkSighting>(&m.data).expect("sighting");
                 ranged += usize::from(s.kind == SightingKind::BearingRange as u32);
+                lines += usize::from(s.kind == SightingKind::GroundLine as u32);
             }
             _ => {}
         }
@@ -60,7 +64,7 @@ fn run_under(mission: &str, condition: &str, seed: u64, tag: &str) -> Maps {
         })
         .map(|m| m.header.stamp_ns)
         .collect();
-    Maps { maps, outside, ranged }
+    Maps { maps, outside, ranged, lines }
 }
 
 #[test]
@@ -83,39 +87,51 @@ fn landmarks_keep_the_map_several_times_smaller_than_dead_reckoning() {
 }
 
 #[test]
-fn the_signs_ranged_too_keep_the_map_smaller_and_lose_the_truth_no_more_often() {
+fn each_class_of_landmark_added_keeps_the_map_smaller_and_loses_the_truth_no_more_often() {
+    let missions = ["uncertainty", "uncertainty-signs", "uncertainty-all-classes"];
     for (condition, seeds) in [("ideal", 1..=3), ("nominal", 1..=6), ("dim", 1..=3)] {
         for seed in seeds {
-            let bearings = run_under("missions/uncertainty.toml", condition, seed, "fig80b");
-            let signs = run_under("missions/uncertainty-signs.toml", condition, seed, "fig80s");
+            let runs: Vec<Maps> = missions
+                .iter()
+                .map(|m| run_under(&format!("missions/{m}.toml"), condition, seed, "fig80c"))
+                .collect();
             let mean = |r: &Maps| r.maps.iter().map(|m| m.area_m2).sum::<f64>() / r.maps.len() as f64;
-            let last = |r: &Maps| r.maps.last().expect("maps").area_m2;
-            println!(
-                "{condition} s{seed}: with the signs {:.4} m^2 after 20 ft (mean {:.4}), truth outside {} of {} maps, \
-                 {} signs ranged; class I only {:.4} m^2 (mean {:.4}), truth outside {} of {}",
-                last(&signs),
-                mean(&signs),
-                signs.outside.len(),
-                signs.maps.len(),
-                signs.ranged,
-                last(&bearings),
-                mean(&bearings),
-                bearings.outside.len(),
-                bearings.maps.len()
+            for (m, r) in missions.iter().zip(&runs) {
+                println!(
+                    "{condition} s{seed} {m}: {:.4} m^2 after 20 ft, mean {:.4}; truth outside {} of {} maps; \
+                     {} ranged, {} lines",
+                    r.maps.last().expect("maps").area_m2,
+                    mean(r),
+                    r.outside.len(),
+                    r.maps.len(),
+                    r.ranged,
+                    r.lines
+                );
+            }
+            let [bearings, signs, all] = [&runs[0], &runs[1], &runs[2]];
+            assert_eq!(
+                (bearings.ranged, bearings.lines, signs.lines),
+                (0, 0, 0),
+                "each class only where asked"
             );
-            assert_eq!(bearings.ranged, 0, "class I only: no ranged sightings");
-            assert!(signs.ranged > 10, "{condition} s{seed}: {} signs ranged", signs.ranged);
-            assert!(mean(&signs) < mean(&bearings), "{condition} s{seed}: the signs did not shrink the map");
             assert!(
-                signs.outside.len() <= bearings.outside.len(),
-                "{condition} s{seed}: {:?}",
-                signs.outside
+                signs.ranged > 10 && all.lines > 10,
+                "{condition} s{seed}: {} ranged, {} lines",
+                signs.ranged,
+                all.lines
             );
+            assert!(
+                mean(signs) < mean(bearings) && mean(all) < mean(signs),
+                "{condition} s{seed}: not smaller"
+            );
+            for r in [signs, all] {
+                assert!(r.outside.len() <= bearings.outside.len(), "{condition} s{seed}: {:?}", r.outside);
+            }
         }
     }
 }
 
 #[test]
-fn a_run_with_the_signs_ranged_replays_identically_as_processes() {
-    common::assert_replays("missions/uncertainty-signs.toml", "fig80rp", &[]);
+fn a_run_with_every_class_of_landmark_replays_identically_as_processes() {
+    common::assert_replays("missions/uncertainty-all-classes.toml", "fig80rp", &[]);
 }

@@ -7,6 +7,7 @@ use clap::Parser;
 use crate::VerticalEdges;
 use crate::dispatch::Dispatcher;
 use crate::landmarks::LineLandmarks;
+use crate::landmarks::ground::GroundLines;
 use crate::landmarks::point::PointLandmarks;
 use crate::odometry_config::OdometryConfig;
 use harvey_msgs::{
@@ -33,6 +34,10 @@ pub struct Args {
     /// 002 §3.4), not only class I (`false`: class I only, as the missions that predate it).
     #[arg(long, default_value_t = false, action = clap::ArgAction::Set)]
     pub point_landmarks: bool,
+    /// Look for class III landmarks too (a wall's foot with its baseboard: the robot's heading
+    /// relative to it and its distance from it, 002 §3.4).
+    #[arg(long, default_value_t = false, action = clap::ArgAction::Set)]
+    pub ground_landmarks: bool,
     /// Expectations older than this (message time) are not searched for.
     #[arg(long, default_value_t = 300)]
     pub expectation_max_age_ms: u64,
@@ -94,6 +99,8 @@ pub struct Workers {
     lines: LineLandmarks,
     /// The class II recogniser, when asked for (`--point-landmarks`).
     points: Option<PointLandmarks>,
+    /// The class III recogniser, when asked for (`--ground-landmarks`).
+    grounds: Option<GroundLines>,
     new_expectations: Vec<Expectation>,
     new_requests: Vec<VisionRequest>,
     processed: u64,
@@ -146,16 +153,21 @@ impl Node for Workers {
             self.lines.focal_px = self.camera.focal_for(h.width_px);
             kept.wanted.retain(|_, e| e.header.stamp_ns + self.max_age_ns >= h.stamp_ns);
             for e in kept.wanted.values().filter(|_| self.landmarks) {
-                let point = match (&mut self.points, e.class) {
-                    (Some(points), 2) => {
+                let point = match (&mut self.points, &mut self.grounds, e.class) {
+                    (Some(points), _, 2) => {
                         points.focal_px = self.lines.focal_px;
-                        points.recognise(&h, pixels, e).map(|mut s| {
-                            self.lines.number(&mut s);
-                            s
-                        })
+                        points.recognise(&h, pixels, e)
+                    }
+                    (_, Some(grounds), 3) => {
+                        grounds.focal_px = self.lines.focal_px;
+                        grounds.recognise(&h, pixels, e)
                     }
                     _ => None,
-                };
+                }
+                .map(|mut s| {
+                    self.lines.number(&mut s);
+                    s
+                });
                 if let Some(s) = point.or_else(|| self.lines.recognise(&h, pixels, e)) {
                     self.found += u64::from(s.kind != 0);
                     io.send(self.sightings, &s)?;
@@ -222,6 +234,7 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<Workers> {
             .with_calibration_sd(world.survey.calibration_sd_rad)
             .with_blur(world.camera.blur_px),
         points: args.point_landmarks.then(|| PointLandmarks::new(&world, world.survey.calibration_sd_rad)),
+        grounds: args.ground_landmarks.then(|| GroundLines::new(&world, world.survey.calibration_sd_rad)),
         dispatcher: Dispatcher::new(world.clone()).with_odometry(odometry),
         camera: world.camera,
         new_expectations: Vec::new(),

@@ -1,0 +1,253 @@
+//! Recognising a class III landmark (002 §3.4: a ground line, here a wall's foot with its
+//! baseboard) in the Expecter's window. The map gives the band painted along the foot: its top
+//! edge's height and whether it is darker than the wall above. Column by column, the strongest
+//! step of that sign going down (below the horizon) is the band's top edge; each edge point is
+//! projected onto the plane of the edge's height, giving points on the floor plan in the robot's
+//! frame; a line fitted to them with its outliers trimmed (a doorway, a tile's edge) gives the
+//! robot's heading relative to the line and its signed distance from it (left positive). The
+//! robot is taken to head along the line's direction (its first end to its second) within 90
+//! degrees: the landmark's view headings say so.
+
+use harvey_msgs::{Expectation, FrameHeader, Header, LandmarkSighting, SightingKind};
+use harvey_vision::levels::{histogram, percentile};
+use harvey_vision::noise::noise_sigma;
+use harvey_vision::{Gray, Rect};
+use harvey_world::{LandmarkClass, World};
+
+/// A column's edge counts when its step (three rows' means either side) is this many noise
+/// deviations (five of the step's own), and this fraction of the window's median grey, past
+/// nothing.
+const NOISE_SIGMAS: f32 = 4.0;
+const MIN_STEP: f32 = 0.15;
+/// Columns looked at: every second one.
+const COLUMN_STEP: usize = 2;
+/// A fit needs this many points over this much depth (m), nearer than `MAX_DEPTH_M`; a point off
+/// the fit by more than `TRIM_M` (or three median deviations) is trimmed.
+const MIN_POINTS: usize = 8;
+const MIN_SPAN_M: f64 = 0.5;
+const MAX_DEPTH_M: f64 = 12.0;
+const TRIM_M: f64 = 0.05;
+
+/// What the map says of a class III landmark's look.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Band {
+    /// The top edge's height below the camera (m, positive) and whether the band is darker
+    /// than the wall above it.
+    pub below_camera_m: f64,
+    pub darker: bool,
+}
+
+impl Band {
+    /// The class III landmarks of `world` along a wall's foot with a band painted from the floor
+    /// the whole way, by index.
+    pub fn of(world: &World) -> Vec<Option<Band>> {
+        world
+            .landmarks
+            .iter()
+            .map(|l| {
+                let (LandmarkClass::III, Some(to)) = (l.class, l.to_m) else { return None };
+                let a = l.position_m;
+                world.walls.iter().find_map(|w| {
+                    let on = |p: [f64; 3]| {
+                        let len = w.length_m();
+                        let (dx, dy) = ((w.to[0] - w.from[0]) / len, (w.to[1] - w.from[1]) / len);
+                        ((p[0] - w.from[0]) * dy - (p[1] - w.from[1]) * dx).abs() < 0.02
+                    };
+                    if !(on(a) && on(to)) {
+                        return None;
+                    }
+                    let r = w.regions.iter().find(|r| r.height_m[0] <= 0.0 && r.height_m[1] > 0.0)?;
+                    Some(Band {
+                        below_camera_m: world.camera.height_m - r.height_m[1],
+                        darker: r.reflectance < w.reflectance,
+                    })
+                })
+            })
+            .collect()
+    }
+}
+
+/// The class III recogniser.
+#[derive(Debug)]
+pub struct GroundLines {
+    bands: Vec<Option<Band>>,
+    pub focal_px: f64,
+    /// How well the mount's yaw and pitch are known (rad).
+    calibration_sd_rad: f64,
+    points: Vec<[f64; 2]>,
+}
+
+impl GroundLines {
+    pub fn new(world: &World, calibration_sd_rad: f64) -> Self {
+        Self {
+            bands: Band::of(world),
+            focal_px: world.camera.focal_px,
+            calibration_sd_rad,
+            points: Vec::new(),
+        }
+    }
+
+    /// Looks for the class III landmark of `e` in a mono8 frame; the sighting's `seq` is left for
+    /// the caller to number. `None`: not a class III landmark along a band, or a window off the
+    /// frame or of another size.
+    pub fn recognise(&mut self, h: &FrameHeader, pixels: &[u8], e: &Expectation) -> Option<LandmarkSighting> {
+        let band = *self.bands.get(e.landmark_index as usize)?.as_ref()?;
+        let (w, ht) = (h.width_px as usize, h.height_px as usize);
+        if e.class != 3 || (e.width_px, e.height_px) != (h.width_px, h.height_px) {
+            return None;
+        }
+        let img = Gray::new(pixels, w, ht, h.stride_bytes as usize).ok()?;
+        let [u0, v0, u1, v1] = e.window_px.map(|x| x.max(0.0) as usize);
+        let (cx, cy, f) = (w as f64 / 2.0, ht as f64 / 2.0, self.focal_px);
+        // Below the horizon only: the band's edge lies under the camera.
+        let top = v0.max(cy as usize + 3);
+        let win = Rect::new(u0, top, u1.min(w), v1.min(ht)).inside(w, ht).ok()?;
+        let median = f32::from(percentile(&histogram(&img, win), 0.5));
+        let least = (NOISE_SIGMAS * noise_sigma(&img, win)).max(MIN_STEP * median);
+        self.points.clear();
+        for u in (win.x0..win.x1).step_by(COLUMN_STEP) {
+            let at = |v: usize| f32::from(img.at(u, v));
+            // The step across row v: the mean of the three rows below less that of the three
+            // above (a blurred edge spreads over the middle row), negative where it goes darker.
+            let step = |v: usize| {
+                let s = (at(v + 1) + at(v + 2) + at(v + 3) - at(v - 1) - at(v - 2) - at(v - 3)) / 3.0;
+                if band.darker { -s } else { s }
+            };
+            let rows = win.y0 + 3..win.y1.saturating_sub(3);
+            let best = rows.clone().map(|v| (v, step(v))).max_by(|a, b| a.1.total_cmp(&b.1));
+            let Some((v, peak)) = best.filter(|b| b.1 >= least) else { continue };
+            // A sharp edge between rows k - 1 and k steps as much at both: the edge runs through
+            // the middle of the rows near the peak, weighted by their step.
+            let near = (v.saturating_sub(2).max(rows.start)..(v + 3).min(rows.end)).map(|r| (r, step(r)));
+            let (sum, weight) = near
+                .filter(|&(_, s)| s >= peak / 2.0)
+                .fold((0.0, 0.0), |(a, w), (r, s)| (a + (r as f64 + 0.5) * f64::from(s), w + f64::from(s)));
+            let depth = f * band.below_camera_m / (sum / weight - cy);
+            if depth > 0.0 && depth < MAX_DEPTH_M {
+                self.points.push([depth, depth * (cx - (u as f64 + 0.5)) / f]);
+            }
+        }
+        let base = LandmarkSighting {
+            header: Header::new(0, h.stamp_ns),
+            frame_seq: h.seq,
+            landmark_index: e.landmark_index,
+            ..Default::default()
+        };
+        let not_found = LandmarkSighting { kind: SightingKind::NotFound as u32, ..base };
+        let Some(fit) = fit_trimmed(&mut self.points) else { return Some(not_found) };
+        // The line y = a + b x in the robot's frame, along +x: the robot's heading less the
+        // line's direction is -atan b; its distance from the line, left positive, -a / |(1, b)|.
+        let norm = fit.b.hypot(1.0);
+        let heading = -fit.b.atan();
+        let offset = -fit.a / norm;
+        // An unknown pitch (or an edge placed half a row off all along) moves every row alike,
+        // scaling each point's distance by (sd + 0.5 / f) x / h: a line at distance y turns by
+        // y (sd + 0.5 / f) / h, and is extrapolated to the robot a little off (kept at the
+        // points' mean depth's scale, to be safe). An unknown yaw turns the line.
+        let row = self.calibration_sd_rad + 0.5 / f;
+        let turn = offset.abs() * row / band.below_camera_m;
+        Some(LandmarkSighting {
+            kind: SightingKind::GroundLine as u32,
+            a: heading,
+            a_sd: fit.b_sd.hypot(self.calibration_sd_rad).hypot(turn),
+            b: offset,
+            b_sd: fit.a_sd.hypot(turn * fit.mean_x),
+            ..base
+        })
+    }
+}
+
+/// A line `y = a + b x` and its spreads, and the points' mean depth.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Fit {
+    a: f64,
+    b: f64,
+    a_sd: f64,
+    b_sd: f64,
+    mean_x: f64,
+}
+
+/// The line through two of the points (one from the nearer half, one from the further) that the
+/// most points lie within `TRIM_M` of: a doorway's or a tile's edges can outnumber the line's
+/// near a doorway, but they do not line up with each other.
+fn consensus(points: &[[f64; 2]]) -> Option<(f64, f64)> {
+    let mut sorted: Vec<[f64; 2]> = points.to_vec();
+    sorted.sort_by(|p, q| p[0].total_cmp(&q[0]));
+    let (near, far) = sorted.split_at(sorted.len() / 2);
+    let mut best: Option<(usize, f64, (f64, f64))> = None;
+    for p in near {
+        for q in far.iter().filter(|q| q[0] - p[0] > MIN_SPAN_M / 2.0) {
+            let b = (q[1] - p[1]) / (q[0] - p[0]);
+            let a = p[1] - b * p[0];
+            let (count, spread) = points
+                .iter()
+                .map(|r| (r[1] - a - b * r[0]).abs())
+                .filter(|&e| e <= TRIM_M)
+                .fold((0, 0.0), |(n, s), e| (n + 1, s + e));
+            if best.is_none_or(|(n, s, _)| count > n || (count == n && spread < s)) {
+                best = Some((count, spread, (a, b)));
+            }
+        }
+    }
+    best.map(|(_, _, line)| line)
+}
+
+/// Least squares on the consensus line's points, then with the points further than `TRIM_M` (or
+/// three median deviations) from the fit trimmed, three times; none without enough points over
+/// enough depth.
+fn fit_trimmed(points: &mut Vec<[f64; 2]>) -> Option<Fit> {
+    let (a, b) = consensus(points)?;
+    points.retain(|p| (p[1] - a - b * p[0]).abs() <= TRIM_M);
+    let mut fit = least_squares(points)?;
+    for _ in 0..3 {
+        let mut r: Vec<f64> = points.iter().map(|p| (p[1] - fit.a - fit.b * p[0]).abs()).collect();
+        r.sort_by(f64::total_cmp);
+        let gate = (3.0 * 1.4826 * r[r.len() / 2]).max(TRIM_M);
+        points.retain(|p| (p[1] - fit.a - fit.b * p[0]).abs() <= gate);
+        fit = least_squares(points)?;
+    }
+    Some(fit)
+}
+
+fn least_squares(points: &[[f64; 2]]) -> Option<Fit> {
+    let n = points.len();
+    if n < MIN_POINTS {
+        return None;
+    }
+    let k = n as f64;
+    let (mx, my) =
+        (points.iter().map(|p| p[0]).sum::<f64>() / k, points.iter().map(|p| p[1]).sum::<f64>() / k);
+    let sxx: f64 = points.iter().map(|p| (p[0] - mx).powi(2)).sum();
+    let (lo, hi) =
+        points.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| (a.0.min(p[0]), a.1.max(p[0])));
+    if hi - lo < MIN_SPAN_M || sxx <= 0.0 {
+        return None;
+    }
+    let b = points.iter().map(|p| (p[0] - mx) * (p[1] - my)).sum::<f64>() / sxx;
+    let a = my - b * mx;
+    let res = (points.iter().map(|p| (p[1] - a - b * p[0]).powi(2)).sum::<f64>() / (k - 2.0)).sqrt();
+    Some(Fit { a, b, a_sd: res * (1.0 / k + mx * mx / sxx).sqrt(), b_sd: res / sxx.sqrt(), mean_x: mx })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_hallway_s_baseboard_is_a_band_and_a_line_is_fitted_through_strays() {
+        let w = harvey_world::load_str(include_str!("../../../../worlds/hallway.toml"), "hallway")
+            .expect("world");
+        let bands = Band::of(&w);
+        let i = w.landmarks.iter().position(|l| l.name == "north-baseboard").expect("landmark");
+        let b = bands[i].expect("the baseboard");
+        assert!((b.below_camera_m - (1.2 - 0.12)).abs() < 1e-9 && b.darker);
+        assert!(bands.iter().enumerate().all(|(k, x)| k == i || x.is_none()));
+        // Points on y = 1 - 0.05 x with two strays.
+        let mut pts: Vec<[f64; 2]> =
+            (0..20).map(|k| f64::from(k) * 0.3 + 1.0).map(|x| [x, 1.0 - 0.05 * x]).collect();
+        pts.extend([[2.0, 0.4], [3.0, 1.8]]);
+        let fit = fit_trimmed(&mut pts).expect("fits");
+        assert!((fit.a - 1.0).abs() < 1e-9 && (fit.b + 0.05).abs() < 1e-9, "{fit:?}");
+        assert_eq!(pts.len(), 20);
+    }
+}
