@@ -3,7 +3,9 @@
 //! belief it finds the mission's landmark vertices by correlation and refines its pose. In the
 //! ideal world every fix is within the paper's 1.5 in of the truth; over seeds 1..3 under the
 //! shipped sensors (`nominal`) and the `dim` condition, within the budget `docs/evaluation.md`
-//! reports (the map's 1 cm errors alone leave 1.8 in median there).
+//! reports (the map's 1 cm errors alone leave 1.8 in median there). In the ideal world the same
+//! with the vertices chosen by the world model's landmark selection (000 §5.2,
+//! `missions/pose-refine-selected.toml`) instead of listed by hand.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
@@ -12,8 +14,8 @@ use harvey_geometry::INCH;
 use harvey_msgs::{PoseFix, TruePose};
 
 /// Each fix's distance from the truth (in), after checking the run and each fix's belief.
-fn fix_errors_in(condition: &str, seed: u64) -> Vec<f64> {
-    let out = common::run_mission_under("missions/pose-refine.toml", condition, seed, "prefine");
+fn fix_errors_in(mission: &str, condition: &str, seed: u64) -> Vec<f64> {
+    let out = common::run_mission_under(mission, condition, seed, "prefine");
     assert!(out.status.success() && out.stdout.contains("goal reached (4/4 steps)"), "{}", out.stdout);
     let (mut fixes, mut truth) = (Vec::new(), None);
     for m in mcap::MessageStream::new(&out.mcap).expect("mcap") {
@@ -54,24 +56,34 @@ fn fix_errors_in(condition: &str, seed: u64) -> Vec<f64> {
         .collect()
 }
 
-#[test]
-fn in_the_ideal_world_every_fix_is_within_an_inch_and_a_half() {
-    let errors = fix_errors_in("ideal", 1);
-    assert!(errors.iter().all(|&e| e < 1.5), "{errors:?}");
-}
+/// The hand-listed vertices, and those the world model's selection gives (000 §5.2).
+const MISSIONS: [&str; 2] = ["missions/pose-refine.toml", "missions/pose-refine-selected.toml"];
 
 #[test]
+fn in_the_ideal_world_every_fix_is_within_an_inch_and_a_half() {
+    for mission in MISSIONS {
+        let errors = fix_errors_in(mission, "ideal", 1);
+        assert!(errors.iter().all(|&e| e < 1.5), "{mission}: {errors:?}");
+    }
+}
+
+/// The listed vertices (the selected ones' fixes are looser under nominal and dim, up to 2.8
+/// and 4.3 in over seeds 1..10, so that one fix's miss moves the next's belief further than
+/// this test allows: docs/evaluation.md).
+#[test]
 fn over_seeds_and_conditions_fixes_stay_within_the_budget() {
+    let mission = MISSIONS[0];
     let mut worst = Vec::new();
     for condition in ["nominal", "dim"] {
         for seed in 1..=3 {
-            let errors = fix_errors_in(condition, seed);
-            // Seeds 1..10 gave at most 2.5 in (nominal) and 3.5 in (dim).
-            assert!(errors.iter().all(|&e| e < 4.0), "{condition} s{seed}: {errors:?}");
+            let errors = fix_errors_in(mission, condition, seed);
+            // Seeds 1..10 gave at most 2.5 in (nominal) and 3.5 in (dim) with the listed vertices,
+            // 2.8 and 4.3 with the selected ones.
+            assert!(errors.iter().all(|&e| e < 4.0), "{mission} {condition} s{seed}: {errors:?}");
             worst.push(errors.iter().copied().fold(0.0, f64::max));
         }
     }
     worst.sort_by(f64::total_cmp);
     let median = (worst[2] + worst[3]) / 2.0;
-    assert!(median < 2.5, "median of the runs' worst fixes {median:.2} in: {worst:?}");
+    assert!(median < 2.5, "{mission}: median of the runs' worst fixes {median:.2} in: {worst:?}");
 }

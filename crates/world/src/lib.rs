@@ -12,6 +12,7 @@ mod model;
 mod movers;
 mod poles;
 mod raycast;
+pub mod selection;
 pub mod topology;
 
 pub use as_built::{MapError, Survey};

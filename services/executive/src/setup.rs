@@ -161,9 +161,14 @@ impl Site<'_> {
     fn refine_setup(&self) -> Result<Option<RefineSetup>, SetupError> {
         let Some(r) = &self.mission.refine else { return Ok(None) };
         let w = self.world("[mission.refine]")?;
+        // The vertices listed, then those the world model's selection gives (000 §5.2).
+        let selected = r.select_contrast.map_or(Vec::new(), |c| {
+            harvey_world::selection::corners(w, c).into_iter().map(|(p, _, _)| p).collect()
+        });
         let vertices = r
             .vertices_m
             .iter()
+            .chain(&selected)
             .map(|&v| {
                 let dist = |p: [f64; 3]| (0..3).map(|k| (p[k] - v[k]).powi(2)).sum::<f64>();
                 let (i, l) = w

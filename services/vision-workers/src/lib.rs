@@ -10,7 +10,6 @@ pub mod landmarks;
 pub mod odometry;
 pub mod odometry_config;
 pub mod poles;
-pub mod selection;
 pub mod templates;
 
 pub const ALGO_VERTICAL_EDGES: u32 = 1;

@@ -78,7 +78,7 @@ fn selected_vertices_are_found_where_they_project() {
     let truth = Pose2::new(8.0, 0.0, 0.3);
     let img = frame(&w, truth, 9);
     let gray = Gray::new(&img, 640, 480, 640).expect("frame");
-    let chosen = harvey_vision_workers::selection::select(&w, truth, [640, 480], 40.0, 12.0, 0.15);
+    let chosen = harvey_world::selection::select(&w, truth, [640, 480], 40.0, 12.0, 0.15);
     assert!(chosen.len() >= 4, "{chosen:?}");
     let mut c = Correlator::default();
     for v in chosen.iter().take(8) {

@@ -132,5 +132,9 @@ fn check_refine(k: &KeyPath, r: &Refine) -> Result<(), OutOfRange> {
     if let Some(v) = r.max_sd_m {
         check(&k.key("max_sd_m"), v, &LENGTH)?;
     }
+    if let Some(c) = r.select_contrast {
+        // A reflectance step: above nothing (every region would do), at most a whole one.
+        check(&k.key("select_contrast"), c, &Range::above(0.0, 1.0, ""))?;
+    }
     Ok(())
 }

@@ -32,7 +32,7 @@ pub enum MissionError {
     Goal { file: String, table: &'static str, what: &'static str },
     #[error(
         "{file}: mission.step[{index}] needs exactly one finite `move_m` or `turn_deg`, or \
-         `refine_pose` with two or more [mission.refine] vertices_m"
+         `refine_pose` with two or more [mission.refine] vertices_m or its select_contrast"
     )]
     Step { file: String, index: usize },
     #[error("{file}: mission.step[{index}].increment_m must be positive, on a move")]

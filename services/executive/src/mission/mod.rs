@@ -45,7 +45,12 @@ pub struct Step {
 #[serde(deny_unknown_fields)]
 pub struct Refine {
     /// Landmark vertices (world, m) to find by correlation (000 §5.2: where reflectances meet).
+    #[serde(default)]
     pub vertices_m: Vec<[f64; 3]>,
+    /// Or chosen from the world model (000 §5.2): every corner of a painted region whose
+    /// reflectance differs from its wall's by at least this much (those in view of each pose
+    /// are asked for).
+    pub select_contrast: Option<f64>,
     pub template_px: u32,
     pub min_score: f64,
     /// How well the expected pose is known: x, y (m) and heading (degrees).
@@ -168,7 +173,10 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
     for (index, s) in m.steps.iter().enumerate() {
         match (s.move_m, s.turn_deg, s.refine_pose) {
             (Some(v), None, false) | (None, Some(v), false) if v.is_finite() => {}
-            (None, None, true) if m.refine.as_ref().is_some_and(|r| r.vertices_m.len() >= 2) => {}
+            (None, None, true)
+                if m.refine
+                    .as_ref()
+                    .is_some_and(|r| r.vertices_m.len() >= 2 || r.select_contrast.is_some()) => {}
             _ => return Err(MissionError::Step { file: file_name(), index }),
         }
         if let Some(inc) = s.increment_m
