@@ -7,14 +7,12 @@
 //! `docs/evaluation.md` quotes.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
-use harvey_msgs::{Encoding, Expectation, FrameHeader, Pose2, SightingKind};
-use harvey_render::{Effects, Renderer};
-use harvey_vision_workers::landmarks::ground::GroundLines;
-use harvey_world::{LandmarkClass, World};
+mod light;
 
-/// (name, illumination, noise sd, vignetting, blur px), as `conditions/` sets the camera.
-const CONDITIONS: [(&str, f64, f64, f64, u32); 3] =
-    [("nominal", 220.0, 3.0, 0.2, 0), ("dim", 170.0, 5.0, 0.25, 0), ("harsh", 170.0, 8.0, 0.35, 1)];
+use harvey_msgs::{Encoding, Expectation, FrameHeader, Pose2, SightingKind};
+use harvey_vision_workers::landmarks::ground::GroundLines;
+use harvey_world::LandmarkClass;
+use light::{CONDITIONS, SIZE, lit};
 
 #[derive(Debug, Default)]
 struct Tally {
@@ -26,20 +24,9 @@ struct Tally {
     worst: [f64; 2],
 }
 
-fn world() -> World {
-    harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
-}
-
 fn tally(condition: (&str, f64, f64, f64, u32), seed: u64) -> Tally {
-    let (_, light, noise, vignetting, blur) = condition;
-    let mut w = world();
-    (w.camera.illumination, w.camera.noise_sd, w.camera.vignetting, w.camera.blur_px) =
-        (light, noise, vignetting, blur);
-    w.camera.misalignment_sd_rad = 0.0;
-    let (width, height) = (640u32, 480u32);
-    let mut r = Renderer::new(&w, width, height, Encoding::Mono8);
-    let fx = Effects::from_camera(&w.camera, seed);
-    let mut px = vec![0u8; r.frame_bytes()];
+    let (w, mut r, fx, mut px) = lit(condition, seed);
+    let (width, height) = SIZE;
     let mut grounds = GroundLines::new(&w, w.survey.calibration_sd_rad);
     let (i, l) = w.landmarks.iter().enumerate().find(|(_, l)| l.class == LandmarkClass::III).expect("a line");
     let (a, b) = (l.position_m, l.to_m.expect("two ends"));

@@ -10,14 +10,12 @@
 //! Prints the table `docs/evaluation.md` quotes.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
-use harvey_msgs::{Encoding, Expectation, FrameHeader, Pose2, SightingKind};
-use harvey_render::{Effects, Renderer};
-use harvey_vision_workers::landmarks::point::PointLandmarks;
-use harvey_world::{LandmarkClass, World};
+mod light;
 
-/// (name, illumination, noise sd, vignetting, blur px), as `conditions/` sets the camera.
-const CONDITIONS: [(&str, f64, f64, f64, u32); 3] =
-    [("nominal", 220.0, 3.0, 0.2, 0), ("dim", 170.0, 5.0, 0.25, 0), ("harsh", 170.0, 8.0, 0.35, 1)];
+use harvey_msgs::{Encoding, Expectation, FrameHeader, Pose2, SightingKind};
+use harvey_vision_workers::landmarks::point::PointLandmarks;
+use harvey_world::LandmarkClass;
+use light::{CONDITIONS, SIZE, lit, unhidden};
 
 #[derive(Debug, Default)]
 struct Tally {
@@ -33,28 +31,11 @@ struct Tally {
     worst_px: f64,
 }
 
-fn world() -> World {
-    harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads")
-}
-
-fn unhidden(w: &World, pose: Pose2, at: [f64; 2]) -> bool {
-    let (dx, dy) = (at[0] - pose.x_m, at[1] - pose.y_m);
-    let d = dx.hypot(dy);
-    w.cast_ray([pose.x_m, pose.y_m], [dx / d, dy / d], d).is_none_or(|h| h.distance_m > d - 0.05)
-}
-
 /// From poses along the hall, each class II landmark in view searched for in a window of
 /// `half_px` either side of its true place, moved `shift_px` sideways.
 fn tally(condition: (&str, f64, f64, f64, u32), seed: u64, half_px: f64, shift_px: f64) -> Tally {
-    let (_, light, noise, vignetting, blur) = condition;
-    let mut w = world();
-    (w.camera.illumination, w.camera.noise_sd, w.camera.vignetting, w.camera.blur_px) =
-        (light, noise, vignetting, blur);
-    w.camera.misalignment_sd_rad = 0.0;
-    let (width, height) = (640u32, 480u32);
-    let mut r = Renderer::new(&w, width, height, Encoding::Mono8);
-    let fx = Effects::from_camera(&w.camera, seed);
-    let mut px = vec![0u8; r.frame_bytes()];
+    let (w, mut r, fx, mut px) = lit(condition, seed);
+    let (width, height) = SIZE;
     let mut points = PointLandmarks::new(&w, w.survey.calibration_sd_rad);
     let mut t = Tally::default();
     let mut seq = 0;
