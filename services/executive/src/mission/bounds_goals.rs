@@ -22,16 +22,16 @@ const RING_CONTRAST: Range = Range::closed(1.0, 4.0, "");
 const AREA_PX: Range = Range::above(0.0, 16_777_216.0, "px");
 /// Angles the behaviours keep within or sweep (bearings, gates): positive, up to half a turn;
 /// a sweep up to a whole turn.
-const HALF_TURN: Range = Range::above(0.0, 180.0, "deg");
+pub(crate) const HALF_TURN: Range = Range::above(0.0, 180.0, "deg");
 const SWEEP: Range = Range::above(0.0, 360.0, "deg");
 /// Speeds: positive, up to the world's fastest robot (10 m/s); the schemas' gains and the noise
 /// are speeds too, and may be zero (the schema left out).
-const SPEED: Range = Range::above(0.0, 10.0, "m/s");
-const GAIN: Range = Range::closed(0.0, 10.0, "m/s");
+pub(crate) const SPEED: Range = Range::above(0.0, 10.0, "m/s");
+pub(crate) const GAIN: Range = Range::closed(0.0, 10.0, "m/s");
 /// The turn rate limit: positive, up to the world's fastest turn (360 deg/s); its gain positive
 /// and at most 100 per second (a tenth of a tick's correction at 1 kHz).
-const TURN_RATE: Range = Range::above(0.0, 360.0, "deg/s");
-const TURN_GAIN: Range = Range::above(0.0, 100.0, "per s");
+pub(crate) const TURN_RATE: Range = Range::above(0.0, 360.0, "deg/s");
+pub(crate) const TURN_GAIN: Range = Range::above(0.0, 100.0, "per s");
 /// Waits that may be zero: no longer than the longest mission.
 const WAIT: Range = Range::closed(0.0, TIMEOUT.hi, "s");
 /// Counts of ticks (a fix's period, the noise's persistence): up to a million, more than a

@@ -7,6 +7,7 @@ use harvey_config::spans::KeyPath;
 use serde::Deserialize;
 
 use super::bounds::LENGTH;
+use super::bounds_goals::{GAIN, HALF_TURN, SPEED, TURN_GAIN, TURN_RATE};
 
 /// How the robot finds and takes the doorway (001 §3.2 gives both).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
@@ -90,12 +91,7 @@ pub struct DoorGoal {
     pub drawn_for_m: f64,
 }
 
-/// Speeds and gains: as the other behaviours' (`bounds_goals.rs`).
-const SPEED: Range = Range::above(0.0, 10.0, "m/s");
-const GAIN: Range = Range::closed(0.0, 10.0, "m/s");
-const TURN_RATE: Range = Range::above(0.0, 360.0, "deg/s");
-const TURN_GAIN: Range = Range::above(0.0, 100.0, "per s");
-const HALF_TURN: Range = Range::above(0.0, 180.0, "deg");
+/// A turn towards or away from the wall, a sum's turn into it: up to square.
 const QUARTER_TURN: Range = Range::closed(0.0, 90.0, "deg");
 
 pub(crate) fn check_bounds(k: &KeyPath, d: &DoorGoal) -> Result<(), OutOfRange> {
@@ -137,4 +133,26 @@ pub(crate) fn check_door(d: &DoorGoal) -> Result<(), &'static str> {
         return Err("the schemas variant needs press_mps, avoid_sphere_m, avoid_gain and drawn_in_deg");
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::mission::parse;
+
+    #[test]
+    fn the_door_table_is_read_and_its_parts_must_fit() {
+        let text = include_str!("../../../../missions/door-finding.toml");
+        let m = parse(text, "door-finding.toml").expect("parses");
+        let d = m.door.expect("a door table");
+        assert_eq!((d.variant, d.side.sign(), d.opening), (super::DoorVariant::WallFollow, 1.0, 1));
+        let refused =
+            |from: &str, to: &str| parse(&text.replace(from, to), "d.toml").expect_err("refused").to_string();
+        assert!(refused("door_width_m = [0.5, 1.6]", "door_width_m = [1.6, 0.5]").contains("door_width_m"));
+        assert!(refused("gate_m = 0.08", "gate_m = 0.7").contains("gate_m is not below jump_m"));
+        assert!(
+            refused("variant = \"wall-follow\"", "variant = \"schemas\"").contains("schemas variant needs")
+        );
+        assert!(refused("side = \"left\"", "side = \"up\"").contains("mission.door.side"));
+        assert!(refused("confirm = 2", "confirm = 0").contains("mission.door.confirm"));
+    }
 }
