@@ -147,7 +147,8 @@ mod tests {
         let has = |q: [f64; 3]| c.iter().any(|p| (0..3).all(|k| (p[k] - q[k]).abs() < 1e-9));
         // The closed door's foot where it meets the baseboard's top, the lab doorway's edges at the
         // baseboard's top, the exit sign's corner; nothing on the floor.
-        for q in [[9.0, -1.0, 0.12], [8.1, -1.0, 0.12], [4.0, 1.0, 0.12], [4.9, 1.0, 0.12], [16.0, 0.2, 2.3]] {
+        for q in [[9.0, -1.0, 0.12], [8.1, -1.0, 0.12], [4.0, 1.0, 0.12], [4.9, 1.0, 0.12], [16.0, 0.2, 2.3]]
+        {
             assert!(has(q), "{q:?} not in {c:?}");
         }
         assert!(c.iter().all(|p| p[2] > 0.0));
