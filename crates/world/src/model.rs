@@ -160,9 +160,8 @@ pub struct Camera {
     /// (000 §5.5 Fig. 10 studies 0.001 and 0.010 rad).
     #[serde(default)]
     pub misalignment_sd_rad: f64,
-    /// For an experiment: the mount's true yaw (left positive) and pitch (down positive) exactly,
-    /// radians, instead of a draw (000 §5.5 Fig. 10's 0.000, 0.001 and 0.010 rad of yaw;
-    /// `conditions/mount-*.toml`). The robot's calibration does not know it either.
+    /// For an experiment, the mount's true yaw (left +) and pitch (down +) exactly, rad, not drawn
+    /// (000 §5.5 Fig. 10; `conditions/mount-*.toml`); unknown to the robot too.
     #[serde(default)]
     pub mount_error_rad: Option<[f64; 2]>,
     /// Optical blur: a box filter of this radius in pixels (0: sharp).

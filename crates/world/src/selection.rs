@@ -37,15 +37,13 @@ pub fn corners(world: &World, min_contrast: f64) -> Vec<([f64; 3], f64, usize)> 
             if contrast.abs() < min_contrast {
                 continue;
             }
-            // A band along the floor (a baseboard) whose top edge meets this region's side.
+            // A band along the floor (a baseboard), lower than this region, whose top edge meets
+            // this region's side.
             let band_top = |along: f64| {
                 w.regions
                     .iter()
-                    .filter(|b| {
-                        !std::ptr::eq(*b, r)
-                            && b.height_m[0] <= 0.0
-                            && (b.along_m[0]..=b.along_m[1]).contains(&along)
-                    })
+                    .filter(|b| b.height_m[0] <= 0.0 && b.height_m[1] < r.height_m[1])
+                    .filter(|b| (b.along_m[0]..=b.along_m[1]).contains(&along))
                     .map(|b| b.height_m[1])
                     .next()
             };
@@ -72,8 +70,16 @@ pub fn corners(world: &World, min_contrast: f64) -> Vec<([f64; 3], f64, usize)> 
             }
         }
     }
+    // Strongest first; one vertex where two regions share a corner (a whiteboard and its frame's
+    // shadow line), with the larger step.
     out.sort_by(|a, b| b.1.abs().total_cmp(&a.1.abs()));
-    out
+    let mut kept: Vec<([f64; 3], f64, usize)> = Vec::with_capacity(out.len());
+    for v in out {
+        if !kept.iter().any(|k| (0..3).all(|i| (k.0[i] - v.0[i]).abs() < 1e-6)) {
+            kept.push(v);
+        }
+    }
+    kept
 }
 
 /// The vertices visible from `pose` in a `width x height` image, at least `margin_px` inside it,
@@ -152,5 +158,8 @@ mod tests {
             assert!(has(q), "{q:?} not in {c:?}");
         }
         assert!(c.iter().all(|p| p[2] > 0.0));
+        // The whiteboard's lower corners are its frame's shadow line's upper ones: once each.
+        let shared = c.iter().filter(|p| (p[0] - 14.0).abs() < 1e-9 && (p[2] - 0.9).abs() < 1e-9).count();
+        assert_eq!(shared, 2, "{c:?}");
     }
 }

@@ -39,6 +39,9 @@ pub enum SetupError {
     NoLandmark { file: String, key: String, landmark: String, world: String },
     #[error("{file}: mission.refine: world {world} has no landmark to anchor vertices on")]
     NoAnchor { file: String, world: String },
+    /// Listed and selected, fewer than two vertices to refine a pose from.
+    #[error("{file}: mission.refine: {count} vertices listed and selected; a pose fix needs at least 2")]
+    FewVertices { file: String, count: usize },
     #[error("{file}: mission.ptrans.to: locale {locale}, which world {world} lacks")]
     NoLocale { file: String, locale: String, world: String },
     #[error("{file}: mission.poles: world {world} has no [poles]")]
@@ -181,6 +184,9 @@ impl Site<'_> {
                 Ok((i as u32, [v[0] - p[0], v[1] - p[1], v[2] - p[2]], v))
             })
             .collect::<Result<Vec<_>, SetupError>>()?;
+        if vertices.len() < 2 {
+            return Err(SetupError::FewVertices { file: self.name(), count: vertices.len() });
+        }
         let c = &w.camera;
         Ok(Some(RefineSetup {
             vertices,

@@ -25,7 +25,7 @@ struct Tally {
 }
 
 fn tally(condition: (&str, f64, f64, f64, u32), seed: u64) -> Tally {
-    let (w, mut r, fx, mut px) = lit(condition, seed);
+    let (w, mut r, fx, mut px) = lit(condition, seed, true);
     let (width, height) = SIZE;
     let mut grounds = GroundLines::new(&w, w.survey.calibration_sd_rad);
     let (i, l) = w.landmarks.iter().enumerate().find(|(_, l)| l.class == LandmarkClass::III).expect("a line");
@@ -112,7 +112,8 @@ fn the_baseboard_gives_heading_and_offset_whatever_the_light() {
             all.worst[1]
         );
         assert!(all.asked >= 100, "{}: {} asked", c.0, all.asked);
-        assert!(pct(all.right) >= 80.0, "{}: {:.1} % right", c.0, pct(all.right));
+        // Every look found it on these runs: a bar just under that.
+        assert!(pct(all.right) >= 97.0, "{}: {:.1} % right", c.0, pct(all.right));
         assert_eq!(all.blunders, 0, "{}: {} blunders", c.0, all.blunders);
     }
 }

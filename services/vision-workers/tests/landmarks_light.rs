@@ -24,7 +24,7 @@ struct Tally {
 /// Looks down the hall from poses along it, each class I landmark in view searched for in a
 /// window from `window_px[0]` to `window_px[1]` columns from its true one.
 fn tally(condition: (&str, f64, f64, f64, u32), seed: u64, window_px: [f64; 2]) -> Tally {
-    let (w, mut r, fx, mut px) = lit(condition, seed);
+    let (w, mut r, fx, mut px) = lit(condition, seed, false);
     let (width, height) = SIZE;
     let mut lines = LineLandmarks::new(w.camera.focal_px, 12.0).with_blur(w.camera.blur_px);
     let mut t = Tally::default();

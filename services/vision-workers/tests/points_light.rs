@@ -7,7 +7,9 @@
 //! (blunders among them: past five deviations, another thing taken for the sign) and silent; in
 //! windows beside the sign (moved 120 px off: the sign outside even once the recogniser pads the
 //! window by the sign's size, but for a sign seen close) nothing else may be taken for it.
-//! Prints the table `docs/evaluation.md` quotes.
+//! Prints the table `docs/evaluation.md` quotes. The mount is aligned here: with the shipped
+//! world's 3 mrad drawn, harsh's wider windows took another thing for the sign once in 196
+//! (docs/evaluation.md), a miss left open.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod light;
@@ -34,7 +36,7 @@ struct Tally {
 /// From poses along the hall, each class II landmark in view searched for in a window of
 /// `half_px` either side of its true place, moved `shift_px` sideways.
 fn tally(condition: (&str, f64, f64, f64, u32), seed: u64, half_px: f64, shift_px: f64) -> Tally {
-    let (w, mut r, fx, mut px) = lit(condition, seed);
+    let (w, mut r, fx, mut px) = lit(condition, seed, false);
     let (width, height) = SIZE;
     let mut points = PointLandmarks::new(&w, w.survey.calibration_sd_rad);
     let mut t = Tally::default();

@@ -12,7 +12,7 @@ use harvey_msgs::{BehaviourState, Header, MotionCommand, Pose2, SonarRing};
 
 use super::door_follow;
 use super::door_locate::Look;
-use super::door_schemas;
+use super::door_schemas::{self, Slide};
 use super::drive::{self, DriveParams};
 use super::opening::Opening;
 use super::schemas::V2;
@@ -20,6 +20,8 @@ use super::wall::{Line, Wall};
 use crate::mission::{DoorGoal, DoorVariant};
 
 /// The ring's sensor at the robot's left (90 degrees) and right (270 degrees), and straight ahead.
+/// Located within 10 s of standing (five readings a sensor take 0.75 s), or the mission fails.
+const LOCATE_WITHIN_NS: u64 = 10_000_000_000;
 pub(crate) const LEFT: usize = 6;
 pub(crate) const RIGHT: usize = 18;
 const AHEAD: usize = 0;
@@ -57,14 +59,8 @@ pub struct DoorFinding {
     pub(crate) side_stamp: u64,
     ahead_stamp: u64,
     check_ahead: bool,
-    /// The schemas: whether the wall has been held (the press counterbalanced by its push
-    /// along the fit's window), the travel it has been held over, and the travel at the last
-    /// tick it was.
-    pub(crate) felt_wall: bool,
-    pub(crate) held_m: f64,
-    pub(crate) held_since_m: Option<f64>,
-    /// The schemas: the travel since which the sum has been drawn towards the wall.
-    pub(crate) drawn_since_m: Option<f64>,
+    /// The schemas' slide along the wall.
+    pub(crate) slide: Slide,
     pub(crate) at: Pose2,
     pub(crate) travelled_m: f64,
     /// Door-sized openings passed, and the midpoint of the one taken.
@@ -107,10 +103,7 @@ impl DoorFinding {
             side_stamp: 0,
             ahead_stamp: 0,
             check_ahead: false,
-            felt_wall: false,
-            held_m: 0.0,
-            held_since_m: None,
-            drawn_since_m: None,
+            slide: Slide::default(),
             at: start,
             travelled_m: 0.0,
             openings: 0,
@@ -189,6 +182,11 @@ impl DoorFinding {
             _ if self.done.is_some() => (0.0, 0.0),
             Phase::Locating { since_ns: None } => {
                 self.phase = Phase::Locating { since_ns: Some(now) };
+                (0.0, 0.0)
+            }
+            Phase::Locating { since_ns: Some(t) } if now > t + LOCATE_WITHIN_NS => {
+                tracing::warn!(side = self.side, "no wall located beside the robot");
+                self.done = Some(false);
                 (0.0, 0.0)
             }
             Phase::Locating { since_ns: Some(t) } => {
@@ -287,12 +285,13 @@ impl DoorFinding {
 }
 
 fn phase_index(p: Phase) -> u32 {
+    use Phase::*;
     match p {
-        Phase::Locating { .. } => 0,
-        Phase::Aligning { .. } => 1,
-        Phase::Following => 2,
-        Phase::Backing { .. } => 3,
-        Phase::Facing { .. } => 4,
-        Phase::Through { .. } => 5,
+        Locating { .. } => 0,
+        Aligning { .. } => 1,
+        Following => 2,
+        Backing { .. } => 3,
+        Facing { .. } => 4,
+        Through { .. } => 5,
     }
 }

@@ -2,8 +2,9 @@
 //! 8): each echo within the sphere of influence repels (avoid-static-obstacle), move-ahead
 //! presses the robot along the wall and into it; the wall's push counterbalances the press, and
 //! "when the door opening appears, the obstacle avoidance pressure lessens and the robot moves
-//! into the doorway". Once the schemas' sum turns `drawn_in_deg` towards the wall (after the
-//! robot has slid along the wall, pushed back, over the fit's window), the robot is in the opening: move-ahead then presses straight
+//! into the doorway". Once the schemas' sum has turned `drawn_in_deg` towards the wall over
+//! `drawn_for_m` of travel (after the robot has slid along the wall, pushed back, over the fit's
+//! window), the robot is in the opening: move-ahead then presses straight
 //! through, the jambs' echoes centring it.
 
 use harvey_geometry::wrap;
@@ -12,6 +13,17 @@ use super::door_finding::{DoorFinding, LEFT, RIGHT};
 use super::drive;
 use super::schemas::V2;
 use super::wall::Line;
+
+/// Where the slide stands: whether the wall has been held (the press counterbalanced by its
+/// push over the fit's window), the travel it has been held over and the travel at the last tick
+/// it was; the travel since which the sum has been drawn towards the wall.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct Slide {
+    pub felt_wall: bool,
+    pub held_m: f64,
+    pub held_since_m: Option<f64>,
+    pub drawn_since_m: Option<f64>,
+}
 
 fn unit(a: f64) -> V2 {
     V2::new(a.cos(), a.sin())
@@ -41,23 +53,25 @@ pub(crate) fn slide(d: &mut DoorFinding, parts: &mut [V2; 5]) -> (f64, f64) {
     // The wall is held once the robot has slid along it, pushed back and not drawn in, over the
     // fit's window all told (coming up to the wall, the press still turns the sum towards it;
     // a lost echo now and then lets the push lapse for a reading).
-    if pushed && !drawn && !d.felt_wall {
-        let since = *d.held_since_m.get_or_insert(d.travelled_m);
-        d.held_m += d.travelled_m - since;
-        d.felt_wall = d.held_m >= d.g.fit_m;
+    if pushed && !drawn && !d.slide.felt_wall {
+        let since = *d.slide.held_since_m.get_or_insert(d.travelled_m);
+        d.slide.held_m += d.travelled_m - since;
+        d.slide.felt_wall = d.slide.held_m >= d.g.fit_m;
     }
-    d.held_since_m = (pushed && !drawn).then_some(d.travelled_m);
+    d.slide.held_since_m = (pushed && !drawn).then_some(d.travelled_m);
     // Drawn in over `drawn_for_m` of travel (a lost echo or two beside the wall turn the sum
     // for a moment).
-    let drawn_from = match (d.felt_wall && drawn, d.drawn_since_m) {
+    let drawn_from = match (d.slide.felt_wall && drawn, d.slide.drawn_since_m) {
         (true, Some(from)) => Some(from),
         (true, None) => Some(d.travelled_m),
         (false, _) => None,
     };
-    d.drawn_since_m = drawn_from;
+    d.slide.drawn_since_m = drawn_from;
     if drawn_from.is_some_and(|from| d.travelled_m - from >= d.g.drawn_for_m) {
         tracing::info!(x_m = here[0], y_m = here[1], "drawn into the opening");
         let length = d.wall.line.distance(here) + d.g.through_m;
+        // The doorway counted, and where the robot was drawn in (its middle is not measured).
+        d.openings += 1;
         d.door = Some(here);
         d.enter(here, into, length);
         return (0.0, 0.0);

@@ -50,9 +50,9 @@ pub struct DoorGoal {
     /// An opening counts as a door when its width (as the side sensor's beam sees it) lies in
     /// this range (m); a narrower one is a notch, a wider one the wall's end.
     pub door_width_m: [f64; 2],
-    /// The side range must rise this much above the wall (m) to mean an opening, for `confirm`
-    /// readings in a row (a single far reading is a lost echo or a stray), and come back within
-    /// `gate_m` of the wall, as many times, to mean the wall again.
+    /// The side range must rise this much above the wall (m), or bring no echo, to mean an
+    /// opening, for `confirm` readings in a row (a single far reading is a lost echo or a stray),
+    /// and come back within half of it, as many times, to mean the wall again.
     pub jump_m: f64,
     pub confirm: u32,
     /// The wall's readings over this much travel are fitted to a line (m); a reading further
@@ -124,13 +124,19 @@ pub(crate) fn check_door(d: &DoorGoal) -> Result<(), &'static str> {
     if d.door_width_m[0] >= d.door_width_m[1] {
         return Err("door_width_m's least is not below its most");
     }
-    if d.gate_m >= d.jump_m {
-        return Err("gate_m is not below jump_m (a wall reading would count as an opening)");
+    if d.gate_m >= d.jump_m / 2.0 {
+        return Err("gate_m is not below half of jump_m (a reading on the wall must end an opening)");
     }
     if d.variant == DoorVariant::Schemas
-        && (d.press_mps <= 0.0 || d.avoid_sphere_m <= 0.0 || d.avoid_gain <= 0.0 || d.drawn_in_deg <= 0.0)
+        && (d.along_mps <= 0.0
+            || d.press_mps <= 0.0
+            || d.avoid_sphere_m <= 0.0
+            || d.avoid_gain <= 0.0
+            || d.drawn_in_deg <= 0.0)
     {
-        return Err("the schemas variant needs press_mps, avoid_sphere_m, avoid_gain and drawn_in_deg");
+        return Err(
+            "the schemas variant needs along_mps, press_mps, avoid_sphere_m, avoid_gain and drawn_in_deg",
+        );
     }
     Ok(())
 }
@@ -148,7 +154,7 @@ mod tests {
         let refused =
             |from: &str, to: &str| parse(&text.replace(from, to), "d.toml").expect_err("refused").to_string();
         assert!(refused("door_width_m = [0.5, 1.6]", "door_width_m = [1.6, 0.5]").contains("door_width_m"));
-        assert!(refused("gate_m = 0.08", "gate_m = 0.7").contains("gate_m is not below jump_m"));
+        assert!(refused("gate_m = 0.08", "gate_m = 0.4").contains("gate_m is not below half of jump_m"));
         assert!(
             refused("variant = \"wall-follow\"", "variant = \"schemas\"").contains("schemas variant needs")
         );

@@ -22,7 +22,7 @@ const MIN_STEP: f32 = 0.15;
 /// Columns looked at: every second one.
 const COLUMN_STEP: usize = 2;
 /// A fit needs this many points over this much depth (m), nearer than `MAX_DEPTH_M`; a point off
-/// the fit by more than `TRIM_M` (or three median deviations) is trimmed.
+/// the fit by more than both `TRIM_M` and three median deviations is trimmed.
 const MIN_POINTS: usize = 8;
 const MIN_SPAN_M: f64 = 0.5;
 const MAX_DEPTH_M: f64 = 12.0;
@@ -35,11 +35,13 @@ pub struct Band {
     /// than the wall above it.
     pub below_camera_m: f64,
     pub darker: bool,
+    /// How well the map knows the edge's height (m).
+    pub height_sd_m: f64,
 }
 
 impl Band {
     /// The class III landmarks of `world` along a wall's foot with a band painted from the floor
-    /// the whole way, by index.
+    /// (the lowest, on the first wall on the line), by index.
     pub fn of(world: &World) -> Vec<Option<Band>> {
         world
             .landmarks
@@ -48,18 +50,25 @@ impl Band {
                 let (LandmarkClass::III, Some(to)) = (l.class, l.to_m) else { return None };
                 let a = l.position_m;
                 world.walls.iter().find_map(|w| {
-                    let on = |p: [f64; 3]| {
-                        let len = w.length_m();
-                        let (dx, dy) = ((w.to[0] - w.from[0]) / len, (w.to[1] - w.from[1]) / len);
-                        ((p[0] - w.from[0]) * dy - (p[1] - w.from[1]) * dx).abs() < 0.02
-                    };
-                    if !(on(a) && on(to)) {
+                    let len = w.length_m();
+                    let (dx, dy) = ((w.to[0] - w.from[0]) / len, (w.to[1] - w.from[1]) / len);
+                    let along = |p: [f64; 3]| (p[0] - w.from[0]) * dx + (p[1] - w.from[1]) * dy;
+                    let on = |p: [f64; 3]| ((p[0] - w.from[0]) * dy - (p[1] - w.from[1]) * dx).abs() < 0.02;
+                    // A wall on the line (a line past doorways runs along several), overlapping it.
+                    let (lo, hi) = (along(a).min(along(to)), along(a).max(along(to)));
+                    if !(on(a) && on(to)) || hi <= 0.0 || lo >= len {
                         return None;
                     }
-                    let r = w.regions.iter().find(|r| r.height_m[0] <= 0.0 && r.height_m[1] > 0.0)?;
+                    // Its lowest band standing on the floor, below the camera.
+                    let r = w
+                        .regions
+                        .iter()
+                        .filter(|r| r.height_m[0] <= 0.0 && r.height_m[1] < world.camera.height_m)
+                        .min_by(|p, q| p.height_m[1].total_cmp(&q.height_m[1]))?;
                     Some(Band {
                         below_camera_m: world.camera.height_m - r.height_m[1],
                         darker: r.reflectance < w.reflectance,
+                        height_sd_m: world.survey.position_sd_m.max(l.position_sd_m),
                     })
                 })
             })
@@ -151,7 +160,11 @@ impl GroundLines {
             a: heading,
             a_sd: fit.b_sd.hypot(self.calibration_sd_rad).hypot(turn),
             b: offset,
-            b_sd: fit.a_sd.hypot(turn * fit.mean_x),
+            // The edge's height off by the map's error scales every distance alike.
+            b_sd: fit
+                .a_sd
+                .hypot(turn * fit.mean_x)
+                .hypot(offset.abs() * band.height_sd_m / band.below_camera_m),
             ..base
         })
     }
@@ -192,8 +205,8 @@ fn consensus(points: &[[f64; 2]]) -> Option<(f64, f64)> {
     best.map(|(_, _, line)| line)
 }
 
-/// Least squares on the consensus line's points, then with the points further than `TRIM_M` (or
-/// three median deviations) from the fit trimmed, three times; none without enough points over
+/// Least squares on the consensus line's points, then with the points further than both `TRIM_M`
+/// and three median deviations from the fit trimmed, three times; none without enough points over
 /// enough depth.
 fn fit_trimmed(points: &mut Vec<[f64; 2]>) -> Option<Fit> {
     let (a, b) = consensus(points)?;

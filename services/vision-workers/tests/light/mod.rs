@@ -13,16 +13,22 @@ pub const CONDITIONS: [(&str, f64, f64, f64, u32); 3] =
 /// The image size the tests render.
 pub const SIZE: (u32, u32) = (640, 480);
 
-/// The hallway under `condition`, its mount exactly aligned, with a renderer and the camera's
-/// effects for `seed`, and a frame to render into.
-pub fn lit(condition: (&str, f64, f64, f64, u32), seed: u64) -> (World, Renderer, Effects, Vec<u8>) {
+/// The hallway under `condition`, with a renderer and the camera's effects for `seed`, and a
+/// frame to render into; its mount exactly aligned, or (`mounted`) off by the shipped world's
+/// seeded draw (about 3 mrad of yaw and of pitch, which the recognisers' spreads take in).
+pub fn lit(
+    condition: (&str, f64, f64, f64, u32),
+    seed: u64,
+    mounted: bool,
+) -> (World, Renderer, Effects, Vec<u8>) {
     let (_, light, noise, vignetting, blur) = condition;
     let mut w =
         harvey_world::load_str(include_str!("../../../../worlds/hallway.toml"), "hallway").expect("loads");
     (w.camera.illumination, w.camera.noise_sd, w.camera.vignetting, w.camera.blur_px) =
         (light, noise, vignetting, blur);
+    let (yaw, pitch) = if mounted { harvey_render::mount_error(&w.camera, seed) } else { (0.0, 0.0) };
     w.camera.misalignment_sd_rad = 0.0;
-    let r = Renderer::new(&w, SIZE.0, SIZE.1, Encoding::Mono8);
+    let r = Renderer::new(&w, SIZE.0, SIZE.1, Encoding::Mono8).misaligned(yaw, pitch);
     let fx = Effects::from_camera(&w.camera, seed);
     let px = vec![0u8; r.frame_bytes()];
     (w, r, fx, px)
