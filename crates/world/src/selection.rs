@@ -4,6 +4,7 @@
 //! distinctive: the reflectance step across them is large. These are the points whose
 //! appearance templates (the vision workers' `templates.rs`) correlation then finds; the
 //! executive's plan-level servoing asks for them (`corners`) when a mission selects its vertices.
+//! `Wall::local` places a point in a wall's frame (the recognisers find their landmark's paint).
 
 use crate::{Pose2, World};
 
@@ -17,6 +18,17 @@ pub struct Vertex {
     /// lighter).
     pub contrast: f64,
     pub wall: usize,
+}
+
+impl crate::Wall {
+    /// A point of the floor plan in the wall's frame: how far along it from `from`, and how far
+    /// off its line, left of `from -> to` positive (m).
+    pub fn local(&self, p: [f64; 2]) -> (f64, f64) {
+        let len = self.length_m();
+        let (dx, dy) = ((self.to[0] - self.from[0]) / len, (self.to[1] - self.from[1]) / len);
+        let (rx, ry) = (p[0] - self.from[0], p[1] - self.from[1]);
+        (rx * dx + ry * dy, ry * dx - rx * dy)
+    }
 }
 
 /// Every vertex of the world where a painted region's corner meets its wall's paint with a

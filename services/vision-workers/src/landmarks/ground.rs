@@ -51,9 +51,8 @@ impl Band {
                 let a = l.position_m;
                 world.walls.iter().find_map(|w| {
                     let len = w.length_m();
-                    let (dx, dy) = ((w.to[0] - w.from[0]) / len, (w.to[1] - w.from[1]) / len);
-                    let along = |p: [f64; 3]| (p[0] - w.from[0]) * dx + (p[1] - w.from[1]) * dy;
-                    let on = |p: [f64; 3]| ((p[0] - w.from[0]) * dy - (p[1] - w.from[1]) * dx).abs() < 0.02;
+                    let along = |p: [f64; 3]| w.local([p[0], p[1]]).0;
+                    let on = |p: [f64; 3]| w.local([p[0], p[1]]).1.abs() < 0.02;
                     // A wall on the line (a line past doorways runs along several), overlapping it.
                     let (lo, hi) = (along(a).min(along(to)), along(a).max(along(to)));
                     if !(on(a) && on(to)) || hi <= 0.0 || lo >= len {

@@ -56,10 +56,8 @@ impl Point {
                 }
                 let p = l.position_m;
                 world.walls.iter().find_map(|w| {
-                    let len = w.length_m();
-                    let (dx, dy) = ((w.to[0] - w.from[0]) / len, (w.to[1] - w.from[1]) / len);
-                    let (rx, ry) = (p[0] - w.from[0], p[1] - w.from[1]);
-                    let (along, off) = (rx * dx + ry * dy, (rx * dy - ry * dx).abs());
+                    let (along, off) = w.local([p[0], p[1]]);
+                    let off = off.abs();
                     let r = w.regions.iter().find(|r| {
                         off < 0.02
                             && (r.along_m[0]..=r.along_m[1]).contains(&along)
