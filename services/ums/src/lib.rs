@@ -148,7 +148,10 @@ impl Ums {
             step.turn_rad = map::wrap(o.turned_rad - self.turned_rad);
             let sign = if o.command.distance_m < 0.0 { -1.0 } else { 1.0 };
             step.run_m = sign * (o.travelled_m - self.travelled_m).max(0.0);
-            step.first_run = step.run_m != 0.0 && !self.run_started;
+            // The inertial loss (002 §3.2) is a MOVE's, starting from rest; a velocity command
+            // steers a robot already rolling (the simulator loses none at its start either).
+            let from_rest = o.command.kind != harvey_msgs::CommandKind::Velocity as u32;
+            step.first_run = step.run_m != 0.0 && !self.run_started && from_rest;
             self.run_started |= step.first_run;
             (self.travelled_m, self.turned_rad) = (o.travelled_m, o.turned_rad);
         }
