@@ -9,6 +9,7 @@
 //! a threshold lowered in a dim window: the same edge counts in a dim frame, a vignetted corner
 //! or under a passing cloud as in a bright one.
 
+pub mod band;
 pub mod ground;
 pub mod point;
 mod profile;

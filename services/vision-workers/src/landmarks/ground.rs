@@ -1,18 +1,23 @@
-//! Recognising a class III landmark (002 §3.4: a ground line, here a wall's foot with its
-//! baseboard) in the Expecter's window. The map gives the band painted along the foot: its top
-//! edge's height and whether it is darker than the wall above. Column by column, the strongest
-//! step of that sign going down (below the horizon) is the band's top edge; each edge point is
-//! projected onto the plane of the edge's height, giving points on the floor plan in the robot's
-//! frame; a line fitted to them with its outliers trimmed (a doorway, a tile's edge) gives the
-//! robot's heading relative to the line and its signed distance from it (left positive). The
-//! robot is taken to head along the line's direction (its first end to its second) within 90
-//! degrees: the landmark's view headings say so.
+//! Recognising a class III landmark (002 §3.4: a ground line) in the Expecter's window: a wall's
+//! foot with its baseboard, or a floor edge where two floors meet (a path's edge on its lawn).
+//! The map (`band.rs`) gives the edge's height below the camera (a band's top, or the floor) and
+//! which way it steps going down an image column (a band darker than the wall above it; for a
+//! floor edge, the near floor's reflectance less the far one's). Column by column, the strongest
+//! step of that sign going down (below the horizon) is the edge; each edge point is projected
+//! onto the plane of the edge's height, giving points on the floor plan in the robot's frame; a
+//! line fitted to them with its outliers trimmed (a doorway, a tile's edge) gives the robot's
+//! heading relative to the line and its signed distance from it (left positive). The robot is
+//! taken to head along the line's direction (its first end to its second) within 90 degrees:
+//! the landmark's view headings say so. So a line seen on the left (the window's middle left of
+//! the image's) has the robot on its right, which is the near side of a floor edge.
 
 use harvey_msgs::{Expectation, FrameHeader, Header, LandmarkSighting, SightingKind};
 use harvey_vision::levels::{histogram, percentile};
 use harvey_vision::noise::noise_sigma;
 use harvey_vision::{Gray, Rect};
-use harvey_world::{LandmarkClass, World};
+use harvey_world::World;
+
+use super::band::Band;
 
 /// A column's edge counts when its step (three rows' means either side) is this many noise
 /// deviations (five of the step's own), and this fraction of the window's median grey, past
@@ -27,53 +32,6 @@ const MIN_POINTS: usize = 8;
 const MIN_SPAN_M: f64 = 0.5;
 const MAX_DEPTH_M: f64 = 12.0;
 const TRIM_M: f64 = 0.05;
-
-/// What the map says of a class III landmark's look.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Band {
-    /// The top edge's height below the camera (m, positive) and whether the band is darker
-    /// than the wall above it.
-    pub below_camera_m: f64,
-    pub darker: bool,
-    /// How well the map knows the edge's height (m).
-    pub height_sd_m: f64,
-}
-
-impl Band {
-    /// The class III landmarks of `world` along a wall's foot with a band painted from the floor
-    /// (the lowest, on the first wall on the line), by index.
-    pub fn of(world: &World) -> Vec<Option<Band>> {
-        world
-            .landmarks
-            .iter()
-            .map(|l| {
-                let (LandmarkClass::III, Some(to)) = (l.class, l.to_m) else { return None };
-                let a = l.position_m;
-                world.walls.iter().find_map(|w| {
-                    let len = w.length_m();
-                    let along = |p: [f64; 3]| w.local([p[0], p[1]]).0;
-                    let on = |p: [f64; 3]| w.local([p[0], p[1]]).1.abs() < 0.02;
-                    // A wall on the line (a line past doorways runs along several), overlapping it.
-                    let (lo, hi) = (along(a).min(along(to)), along(a).max(along(to)));
-                    if !(on(a) && on(to)) || hi <= 0.0 || lo >= len {
-                        return None;
-                    }
-                    // Its lowest band standing on the floor, below the camera.
-                    let r = w
-                        .regions
-                        .iter()
-                        .filter(|r| r.height_m[0] <= 0.0 && r.height_m[1] < world.camera.height_m)
-                        .min_by(|p, q| p.height_m[1].total_cmp(&q.height_m[1]))?;
-                    Some(Band {
-                        below_camera_m: world.camera.height_m - r.height_m[1],
-                        darker: r.reflectance < w.reflectance,
-                        height_sd_m: world.survey.position_sd_m.max(l.position_sd_m),
-                    })
-                })
-            })
-            .collect()
-    }
-}
 
 /// The class III recogniser.
 #[derive(Debug)]
@@ -96,8 +54,8 @@ impl GroundLines {
     }
 
     /// Looks for the class III landmark of `e` in a mono8 frame; the sighting's `seq` is left for
-    /// the caller to number. `None`: not a class III landmark along a band, or a window off the
-    /// frame or of another size.
+    /// the caller to number. `None`: not a class III landmark along a band or a floor edge, or a
+    /// window off the frame or of another size.
     pub fn recognise(&mut self, h: &FrameHeader, pixels: &[u8], e: &Expectation) -> Option<LandmarkSighting> {
         let band = *self.bands.get(e.landmark_index as usize)?.as_ref()?;
         let (w, ht) = (h.width_px as usize, h.height_px as usize);
@@ -112,6 +70,7 @@ impl GroundLines {
         let win = Rect::new(u0, top, u1.min(w), v1.min(ht)).inside(w, ht).ok()?;
         let median = f32::from(percentile(&histogram(&img, win), 0.5));
         let least = (NOISE_SIGMAS * noise_sigma(&img, win)).max(MIN_STEP * median);
+        let darker = band.darker_below(((win.x0 + win.x1) as f64) / 2.0 < cx);
         self.points.clear();
         for u in (win.x0..win.x1).step_by(COLUMN_STEP) {
             let at = |v: usize| f32::from(img.at(u, v));
@@ -119,7 +78,7 @@ impl GroundLines {
             // above (a blurred edge spreads over the middle row), negative where it goes darker.
             let step = |v: usize| {
                 let s = (at(v + 1) + at(v + 2) + at(v + 3) - at(v - 1) - at(v - 2) - at(v - 3)) / 3.0;
-                if band.darker { -s } else { s }
+                if darker { -s } else { s }
             };
             let rows = win.y0 + 3..win.y1.saturating_sub(3);
             let best = rows.clone().map(|v| (v, step(v))).max_by(|a, b| a.1.total_cmp(&b.1));
@@ -159,7 +118,8 @@ impl GroundLines {
             a: heading,
             a_sd: fit.b_sd.hypot(self.calibration_sd_rad).hypot(turn),
             b: offset,
-            // The edge's height off by the map's error scales every distance alike.
+            // The edge's height off by the map's error (a floor edge's: the camera's height over
+            // the floor, known to the survey's accuracy) scales every distance alike.
             b_sd: fit
                 .a_sd
                 .hypot(turn * fit.mean_x)
@@ -244,6 +204,7 @@ fn least_squares(points: &[[f64; 2]]) -> Option<Fit> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::landmarks::band::Edge;
 
     #[test]
     fn the_hallway_s_baseboard_is_a_band_and_a_line_is_fitted_through_strays() {
@@ -252,7 +213,7 @@ mod tests {
         let bands = Band::of(&w);
         let i = w.landmarks.iter().position(|l| l.name == "north-baseboard").expect("landmark");
         let b = bands[i].expect("the baseboard");
-        assert!((b.below_camera_m - (1.2 - 0.12)).abs() < 1e-9 && b.darker);
+        assert!((b.below_camera_m - (1.2 - 0.12)).abs() < 1e-9 && b.edge == Edge::Baseboard { darker: true });
         assert!(bands.iter().enumerate().all(|(k, x)| k == i || x.is_none()));
         // Points on y = 1 - 0.05 x with two strays.
         let mut pts: Vec<[f64; 2]> =
