@@ -67,14 +67,38 @@ pub enum VisionAlgorithm {
     /// against this one). A mono frame is a bad frame; a world without a stereo baseline or a
     /// worker without settings, a bad parameter.
     StereoOdometry = 9,
+    /// Path following with the line finder (001 §2.1), best as a standing request: the line
+    /// finder's fragments in the window (below the horizon) grouped into the path's two edges
+    /// near their predicted places, the edges giving the centreline; each confident fit predicts
+    /// the next frame's edges (feed-forward), and where the fit falls short the tolerances are
+    /// widened once. The first request of an id, or one whose parameters differ from the last,
+    /// starts the tracking afresh from its edges. params: the left edge's column at the window's
+    /// top and bottom rows, the right edge's likewise, the grouping's distance (px, default 30)
+    /// and angle (degrees, default 10), the least total fragment length of a fit (px, default
+    /// 60), and a free number (a new value starts the tracking afresh from the same edges). Items: `[vanishing_u, vanishing_v, bottom_u, bottom_v, confidence, 0]` the
+    /// centreline through the edges' vanishing point and the middle of the path at the window's
+    /// bottom row, then each edge (left, right) `[u, v, angle, 0, 0, 0]` (a point and the
+    /// direction in radians). `NotFound`: no confident fit (the prediction is kept).
+    Path = 10,
 }
 
 impl VisionAlgorithm {
     pub fn from_raw(raw: u32) -> Option<Self> {
         use VisionAlgorithm::*;
-        [Correlate, Moravec, LineFinder, RegionSegmenter, Phototropic, Activity, Dock, Poles, StereoOdometry]
-            .into_iter()
-            .find(|a| *a as u32 == raw)
+        [
+            Correlate,
+            Moravec,
+            LineFinder,
+            RegionSegmenter,
+            Phototropic,
+            Activity,
+            Dock,
+            Poles,
+            StereoOdometry,
+            Path,
+        ]
+        .into_iter()
+        .find(|a| *a as u32 == raw)
     }
 }
 

@@ -1,6 +1,6 @@
 //! Path following with the line finder (001 §2.1): the line fragments near each predicted path
 //! edge (close to it, of like orientation, below the vanishing point) are grouped into one edge
-//! by the length-weighted centre of their midpoints and their length-weighted orientation; the
+//! by the principal axis of their ends, weighted by length and gradient; the
 //! two edges give the centreline, and the fragments' total length is the confidence. Each fit
 //! is fed forward as the next frame's prediction; when confidence falls short, the tolerances
 //! are widened once before the path counts as lost.
@@ -44,10 +44,15 @@ impl ImageLine {
     }
 }
 
+/// The distance a fragment's middle may lie from its predicted edge at the horizon (pixels).
+const MIN_DISTANCE_PX: f32 = 2.0;
+
 /// Tolerances of the grouping.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathParams {
-    /// A fragment's midpoint within this distance of the predicted edge (pixels)…
+    /// A fragment's midpoint within this distance of the predicted edge at the bottom row
+    /// (pixels), shrinking with perspective to 2 px at the horizon (a lateral tolerance on the
+    /// ground)…
     pub max_distance_px: f32,
     /// …and its direction within this angle of it (radians).
     pub max_angle: f32,
@@ -67,22 +72,45 @@ pub struct PathFit {
     pub confidence: f32,
 }
 
-/// Groups the fragments of one edge; `None` when none qualifies.
-fn edge(lines: &[Line], predicted: &ImageLine, horizon_v: f32, p: &PathParams) -> Option<(ImageLine, f32)> {
-    let (mut w, mut mx, mut my, mut vx, mut vy) = (0.0, 0.0, 0.0, 0.0, 0.0);
+/// Groups the fragments of one edge; `None` when none qualifies. A fragment belongs when its
+/// middle lies below the horizon within the distance allowed at its row of the predicted edge,
+/// and its direction within the angle. The edge is the principal axis of the fragments' ends,
+/// each end weighted by half its fragment's length times its mean gradient: the middles of a
+/// point-sampled edge's short fragments lie on it even where each fragment's own direction is
+/// some degrees off (a staircase of rows), and a weaker line beside it (a tile's joint) counts
+/// for less.
+fn edge(
+    lines: &[Line],
+    predicted: &ImageLine,
+    (horizon_v, bottom_v): (f32, f32),
+    p: &PathParams,
+) -> Option<(ImageLine, f32)> {
+    let (mut w, mut mx, mut my, mut length) = (0.0, 0.0, 0.0, 0.0);
+    let (mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0);
+    let span = (bottom_v - horizon_v).max(1.0);
     for l in lines {
         let mid = [(l.from[0] + l.to[0]) / 2.0, (l.from[1] + l.to[1]) / 2.0];
         let dir = (l.to[1] - l.from[1]).atan2(l.to[0] - l.from[0]);
         let mut turn = (dir - predicted.angle).rem_euclid(std::f32::consts::PI);
         turn = turn.min(std::f32::consts::PI - turn);
-        if mid[1] <= horizon_v || turn > p.max_angle || predicted.distance(mid) > p.max_distance_px {
+        // The ground's lateral tolerance shrinks in the image towards the vanishing point.
+        let allowed = MIN_DISTANCE_PX + p.max_distance_px * ((mid[1] - horizon_v) / span).clamp(0.0, 1.0);
+        if mid[1] <= horizon_v || turn > p.max_angle || predicted.distance(mid) > allowed {
             continue;
         }
-        // Directions averaged as doubled-angle vectors: a line and its reverse agree.
-        (w, mx, my) = (w + l.length, mx + l.length * mid[0], my + l.length * mid[1]);
-        (vx, vy) = (vx + l.length * (2.0 * dir).cos(), vy + l.length * (2.0 * dir).sin());
+        let k = 0.5 * l.length * l.mean_gradient.max(1.0);
+        for e in [l.from, l.to] {
+            (w, mx, my) = (w + k, mx + k * e[0], my + k * e[1]);
+            (sxx, syy, sxy) = (sxx + k * e[0] * e[0], syy + k * e[1] * e[1], sxy + k * e[0] * e[1]);
+        }
+        length += l.length;
     }
-    (w > 0.0).then(|| (ImageLine { point: [mx / w, my / w], angle: 0.5 * vy.atan2(vx) }, w))
+    if w <= 0.0 {
+        return None;
+    }
+    let (cx, cy) = (mx / w, my / w);
+    let (vxx, vyy, vxy) = (sxx / w - cx * cx, syy / w - cy * cy, sxy / w - cx * cy);
+    Some((ImageLine { point: [cx, cy], angle: 0.5 * (2.0 * vxy).atan2(vxx - vyy) }, length))
 }
 
 /// One grouping of `lines` against the predicted edges, rows above `horizon_v` ignored.
@@ -94,8 +122,8 @@ pub fn group(
     bottom_v: f32,
     p: &PathParams,
 ) -> Option<PathFit> {
-    let (l, wl) = edge(lines, left, horizon_v, p)?;
-    let (r, wr) = edge(lines, right, horizon_v, p)?;
+    let (l, wl) = edge(lines, left, (horizon_v, bottom_v), p)?;
+    let (r, wr) = edge(lines, right, (horizon_v, bottom_v), p)?;
     let vanishing = l.cross(&r)?;
     let bottom = [(l.x_at(bottom_v) + r.x_at(bottom_v)) / 2.0, bottom_v];
     Some(PathFit {

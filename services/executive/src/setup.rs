@@ -11,6 +11,7 @@ use crate::behaviours::docking::Docking;
 use crate::behaviours::door_finding::DoorFinding;
 use crate::behaviours::fsa::{Fsa, FsaError};
 use crate::behaviours::neptune::Neptune;
+use crate::behaviours::path_follow;
 use crate::behaviours::pole_hunt::PoleHunt;
 use crate::behaviours::{Behaviour, Run};
 use crate::mission::{self, Mission, MissionError};
@@ -252,12 +253,23 @@ impl Site<'_> {
     }
 
     /// The docking behaviour or the pole hunt (the acceptor, the camera, the sonar, the seed),
-    /// CMU's navigation (its start), or door finding (the sonar ring's radius, the start).
+    /// CMU's navigation (its start), door finding (the sonar ring's radius, the start), or path
+    /// following (the path's edges, the camera).
     fn behaviour(&self, seed: u64) -> Result<Option<Behaviour>, SetupError> {
         let m = self.mission;
         if let Some(g) = &m.neptune {
             let start = self.world("[mission.neptune]")?.start;
             return Ok(Some(Behaviour::Neptune(Box::new(Neptune::new(g.clone(), start)))));
+        }
+        if let Some(g) = &m.path {
+            let w = self.world("[mission.path]")?;
+            let p = path_follow::in_world(g, w).map_err(|landmark| SetupError::NoLandmark {
+                file: self.name(),
+                key: "mission.path.segments".to_owned(),
+                landmark,
+                world: w.name.clone(),
+            })?;
+            return Ok(Some(Behaviour::Path(Box::new(p))));
         }
         if let Some(g) = &m.door {
             let w = self.world("[mission.door]")?;

@@ -19,6 +19,7 @@ use harvey_world::World;
 
 use crate::odometry::{Odometries, Outcome};
 use crate::odometry_config::OdometryConfig;
+use crate::path::PathTrackers;
 use crate::templates::{AppearanceTemplate, build_into};
 
 /// A worker's kernels and their buffers.
@@ -38,10 +39,12 @@ pub struct Dispatcher {
     dock_scratch: HoughScratch,
     poles: Vec<[f32; 6]>,
     odometries: Odometries,
+    /// Path following keeps a tracker per (standing) request.
+    paths: PathTrackers,
     seq: u64,
 }
 
-fn status_of(e: &VisionError) -> VisionStatus {
+pub(crate) fn status_of(e: &VisionError) -> VisionStatus {
     match e {
         VisionError::WindowOutside(..) => VisionStatus::WindowOutsideFrame,
         VisionError::EmptyTemplate | VisionError::TemplateTooLarge(..) => VisionStatus::BadTemplate,
@@ -93,6 +96,7 @@ impl Dispatcher {
             dock_scratch: HoughScratch::default(),
             poles: Vec::new(),
             odometries: Odometries::default(),
+            paths: PathTrackers::default(),
             seq: 0,
         }
     }
@@ -273,6 +277,7 @@ impl Dispatcher {
                     push([a.centroid[0], a.centroid[1], a.strength, 0.0, 0.0, 0.0]);
                 }
             }
+            VisionAlgorithm::Path => self.paths.answer(&mut self.flf, &img, window, req, &mut push)?,
             VisionAlgorithm::StereoOdometry => {
                 let outcome = self.odometries.answer(&self.world, h, pixels, req, &mut push)?;
                 return Ok(outcome == Outcome::NoSolution);

@@ -9,6 +9,7 @@ pub mod dispatch;
 pub mod landmarks;
 pub mod odometry;
 pub mod odometry_config;
+pub mod path;
 pub mod poles;
 pub mod templates;
 

@@ -1,6 +1,6 @@
 //! How vision results are drawn on the camera image: lines, corners, region centroids, the dock,
 //! poles, correlation matches (a line from where the vertex was expected to where it was
-//! found) and the stereo odometry's obstacle points, one entity per request, taken off once stale; labels only where a result has a few
+//! found), the path's edges and centreline and the stereo odometry's obstacle points, one entity per request, taken off once stale; labels only where a result has a few
 //! items; the light blob's size as a plot; failed requests go to the log.
 
 use harvey_msgs::{VisionAlgorithm, VisionResult, VisionStatus};
@@ -96,6 +96,25 @@ impl RrdWriter {
                     .map(|i| vec![[i.values[3], i.values[4]], [i.values[0], i.values[1]]])
                     .collect();
                 self.rec.log(path.as_str(), &rerun::LineStrips2D::new(moves).with_colors([colour]))
+            }
+            Some(VisionAlgorithm::Path) => {
+                // The centreline and both edges, from the vanishing point down to the window's
+                // bottom row, labelled with the fit's confidence.
+                let Some(c) = items.first().map(|i| i.values) else { return Ok(()) };
+                let (vanishing, bottom_v) = ([c[0], c[1]], c[3]);
+                let mut strips = vec![vec![vanishing, [c[2], bottom_v]]];
+                strips.extend(items.iter().skip(1).map(|i| {
+                    let [u, v, angle, ..] = i.values;
+                    let s = angle.sin();
+                    let x = if s.abs() < 1e-6 { u } else { u + (bottom_v - v) * angle.cos() / s };
+                    vec![vanishing, [x, bottom_v]]
+                }));
+                let mut labels = vec![String::new(); strips.len()];
+                labels[0] = format!("path {:.0} px", c[4]);
+                self.rec.log(
+                    path.as_str(),
+                    &rerun::LineStrips2D::new(strips).with_labels(labels).with_colors([colour]),
+                )
             }
             Some(VisionAlgorithm::StereoOdometry) => {
                 // The obstacle points (after the motion and the counts) where the left image

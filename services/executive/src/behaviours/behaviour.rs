@@ -1,6 +1,6 @@
 //! The acceptor-sequenced behaviours a mission may run instead of a script or a plan (004):
 //! docking and the pole hunt, CMU's stop-go-stop navigation (003) and door finding by sonar
-//! (001 §3.2), behind one face, and
+//! (001 §3.2) and path following (001 §2.1), behind one face, and
 //! run as the executive's mode.
 
 use harvey_msgs::{
@@ -11,6 +11,7 @@ use harvey_msgs::{
 use super::docking::Docking;
 use super::door_finding::DoorFinding;
 use super::neptune::Neptune;
+use super::path_follow::PathFollow;
 use super::pole_hunt::PoleHunt;
 use crate::{Output, Progress};
 
@@ -20,6 +21,7 @@ pub enum Behaviour {
     Poles(Box<PoleHunt>),
     Neptune(Box<Neptune>),
     Door(Box<DoorFinding>),
+    Path(Box<PathFollow>),
 }
 
 impl Behaviour {
@@ -29,13 +31,17 @@ impl Behaviour {
             Self::Poles(p) => p.on_sonar(r),
             Self::Neptune(n) => n.on_sonar(r),
             Self::Door(d) => d.on_sonar(r),
+            Self::Path(_) => {}
         }
     }
 
-    /// The UMS's newest map: docking judges its first pose fix by it.
+    /// The UMS's newest map: docking judges its first pose fix by it, path following takes its
+    /// pose.
     pub fn on_map(&mut self, m: &UncertaintyMap) {
-        if let Self::Docking(d) = self {
-            d.on_map(m);
+        match self {
+            Self::Docking(d) => d.on_map(m),
+            Self::Path(p) => p.on_map(m),
+            _ => {}
         }
     }
 
@@ -44,6 +50,7 @@ impl Behaviour {
             Self::Docking(d) => d.on_vision(r),
             Self::Poles(p) => p.on_vision(r),
             Self::Neptune(n) => n.on_vision(r),
+            Self::Path(p) => p.on_vision(r),
             Self::Door(_) => {}
         }
     }
@@ -58,6 +65,7 @@ impl Behaviour {
             Self::Docking(d) => d.on_odometry(odometry, now),
             Self::Poles(p) => p.on_odometry(odometry, now),
             Self::Neptune(n) => n.on_odometry(odometry, now),
+            Self::Path(p) => p.on_odometry(odometry, now),
             Self::Door(d) => {
                 let (command, state) = d.on_odometry(odometry, now);
                 (None, command, state)
@@ -72,13 +80,14 @@ impl Behaviour {
             Self::Poles(p) => p.done,
             Self::Neptune(n) => n.done,
             Self::Door(d) => d.done,
+            Self::Path(p) => p.done,
         }
     }
 
     /// Whether the mission counts as succeeded if its time runs out now.
     pub fn enough_at_timeout(&self) -> bool {
         match self {
-            Self::Docking(_) | Self::Neptune(_) | Self::Door(_) => false,
+            Self::Docking(_) | Self::Neptune(_) | Self::Door(_) | Self::Path(_) => false,
             Self::Poles(p) => p.enough(),
         }
     }
@@ -88,6 +97,7 @@ impl Behaviour {
         match self {
             Self::Docking(d) => d.believed(),
             Self::Neptune(n) => n.believed(),
+            Self::Path(p) => p.believed(),
             Self::Poles(_) | Self::Door(_) => odometry,
         }
     }
@@ -98,6 +108,7 @@ impl Behaviour {
             Self::Poles(p) => p.goal_pose(),
             Self::Neptune(n) => n.goal_pose(),
             Self::Door(d) => d.goal_pose(),
+            Self::Path(p) => p.goal_pose(),
         }
     }
 }

@@ -6,7 +6,8 @@
 //! (`pole_hunt.rs`) behind one face (`behaviour.rs`), with CMU's stop-go-stop navigation by
 //! stereo (003, `neptune.rs`, its path round the obstacles seen in `grid_plan.rs`), and door
 //! finding by sonar alone (001 §3.2, `door_finding.rs`: the wall followed in `wall.rs`, its
-//! openings told in `opening.rs`, the schema-based way in `door_schemas.rs`).
+//! openings told in `opening.rs`, the schema-based way in `door_schemas.rs`), and path following
+//! by the line finder (001 §2.1, `path_follow.rs`, the camera's view of the path in `path_view.rs`).
 
 pub mod behaviour;
 pub mod dock_pose;
@@ -20,6 +21,8 @@ pub mod fsa;
 pub mod grid_plan;
 pub mod neptune;
 pub mod opening;
+pub mod path_follow;
+pub mod path_view;
 pub mod pole_hunt;
 pub mod region;
 pub mod schemas;

@@ -90,6 +90,9 @@ pub(crate) fn check_bounds(m: &Mission) -> Result<(), OutOfRange> {
     if let Some(d) = &m.door {
         super::door::check_bounds(&root("door"), d)?;
     }
+    if let Some(p) = &m.path {
+        super::path::check_bounds(&root("path"), p)?;
+    }
     Ok(())
 }
 

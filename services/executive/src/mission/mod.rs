@@ -11,11 +11,13 @@ mod bounds_goals;
 pub mod door;
 mod error;
 pub mod goals;
+pub mod path;
 
 pub use door::{DoorGoal, DoorVariant, Side};
 pub use error::MissionError;
 pub use goals::{DockingGoal, NeptuneGoal, PolesGoal, PtransGoal};
 use goals::{check_docking, check_neptune, check_poles, check_ptrans};
+pub use path::PathGoal;
 
 /// One primitive: exactly one of `move_m` and `turn_deg` is set. A move may be driven in
 /// increments, and servoed on a landmark after each (000 §5.5).
@@ -116,6 +118,7 @@ pub struct Mission {
     pub poles: Option<PolesGoal>,
     pub neptune: Option<NeptuneGoal>,
     pub door: Option<DoorGoal>,
+    pub path: Option<PathGoal>,
 }
 
 #[derive(Deserialize)]
@@ -148,7 +151,8 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
         + usize::from(m.docking.is_some())
         + usize::from(m.poles.is_some())
         + usize::from(m.neptune.is_some())
-        + usize::from(m.door.is_some());
+        + usize::from(m.door.is_some())
+        + usize::from(m.path.is_some());
     match (behaviours, m.steps.is_empty()) {
         (0, true) => return Err(MissionError::NothingToDo { file: file_name() }),
         (1, true) | (0, false) => {}
@@ -169,6 +173,9 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
     }
     if let Some(d) = &m.door {
         door::check_door(d).map_err(|what| goal("door", what))?;
+    }
+    if let Some(p) = &m.path {
+        path::check_path(p).map_err(|what| goal("path", what))?;
     }
     for (index, s) in m.steps.iter().enumerate() {
         match (s.move_m, s.turn_deg, s.refine_pose) {

@@ -1,0 +1,88 @@
+//! The path-following request (001 §2.1, `VisionAlgorithm::Path`): the line finder's fragments in
+//! the window grouped into the path's two edges by a tracker kept per request id, bootstrapped
+//! from the request's predicted edges and fed forward from each confident fit.
+
+use std::collections::BTreeMap;
+
+use harvey_msgs::{VisionRequest, VisionStatus};
+use harvey_vision::flf::{Flf, FlfParams};
+use harvey_vision::path::{ImageLine, PathParams, PathTracker};
+use harvey_vision::{Gray, Rect};
+
+/// The line finder's settings for path edges: fragments of at least this length (px), at this
+/// least gradient (grey levels a pixel): a lawn's blades and a paver's joints give short ones.
+const MIN_LENGTH_PX: f32 = 5.0;
+const MIN_GRADIENT: f32 = 8.0;
+/// The gradient floors rise to this many times the window's noise (the line finder's default is
+/// 3.5): a gravel path's edge on a dim day steps little more than that.
+const NOISE_FACTOR: f32 = 1.2;
+
+/// One tracker per request id, with the parameters it was started from (a request of the id with
+/// other parameters starts afresh; one with another window goes on in the new window).
+#[derive(Debug, Default)]
+pub struct PathTrackers {
+    trackers: BTreeMap<u32, ([f32; 8], PathTracker)>,
+}
+
+impl PathTrackers {
+    /// Tracks the path in `window` of `img` for `req`: the fit's items (centreline, left edge,
+    /// right edge) through `push`, none when no fit is confident.
+    pub fn answer(
+        &mut self,
+        flf: &mut Flf,
+        img: &Gray<'_>,
+        window: Rect,
+        req: &VisionRequest,
+        push: &mut impl FnMut([f32; 6]),
+    ) -> Result<(), VisionStatus> {
+        let p = &req.params;
+        let (top, bottom) = (window.y0 as f32, window.y1 as f32 - 1.0);
+        let params = PathParams {
+            max_distance_px: or(p[4], 30.0),
+            max_angle: or(p[5], 10.0).to_radians(),
+            min_confidence: or(p[6], 60.0),
+        };
+        let sane = p[..4].iter().all(|x| x.is_finite())
+            && params.max_distance_px > 0.0
+            && params.max_distance_px < 1000.0
+            && params.max_angle > 0.0
+            && params.max_angle < std::f32::consts::FRAC_PI_2
+            && params.min_confidence > 0.0
+            && bottom > top;
+        if !sane {
+            return Err(VisionStatus::BadParameter);
+        }
+        let fresh = |_: &u32| {
+            let left = ImageLine::through([p[0], top], [p[1], bottom]);
+            let right = ImageLine::through([p[2], top], [p[3], bottom]);
+            (*p, PathTracker::new(left, right, top, bottom, params))
+        };
+        let entry = self.trackers.entry(req.request_id).or_insert_with_key(fresh);
+        if entry.0 != *p {
+            *entry = fresh(&req.request_id);
+        }
+        let tracker = &mut entry.1;
+        let flf_params = FlfParams {
+            min_length: MIN_LENGTH_PX,
+            min_gradient: MIN_GRADIENT,
+            noise_factor: NOISE_FACTOR,
+            ..FlfParams::default()
+        };
+        let lines = flf.lines(img, window, &flf_params).map_err(|e| crate::dispatch::status_of(&e))?;
+        // The horizon the tracker bounds fragments by never rises above the window.
+        tracker.horizon_v = tracker.horizon_v.max(top);
+        if let Some(fit) = tracker.update(lines) {
+            let c = fit.centreline;
+            push([fit.vanishing[0], fit.vanishing[1], c.x_at(bottom), bottom, fit.confidence, 0.0]);
+            for e in [fit.left, fit.right] {
+                push([e.point[0], e.point[1], e.angle, 0.0, 0.0, 0.0]);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// `x`, or `default` when it is zero (unset).
+fn or(x: f32, default: f32) -> f32 {
+    if x == 0.0 { default } else { x }
+}
