@@ -72,8 +72,10 @@ pub enum VisionAlgorithm {
     /// near their predicted places, the edges giving the centreline; each confident fit predicts
     /// the next frame's edges (feed-forward), and where the fit falls short the tolerances are
     /// widened once. The first request of an id, or one whose parameters differ from the last,
-    /// starts the tracking afresh from its edges. params: the left edge's column at the window's
-    /// top and bottom rows, the right edge's likewise, the grouping's distance (px, default 30)
+    /// starts the tracking afresh from its edges. `expected`: `x_m` and `y_m` are the two image
+    /// rows the predicted edges are given at (the window may change under a standing request; the
+    /// tracking goes on in it). params: the left edge's column at those two rows, the right
+    /// edge's likewise, the grouping's distance (px, default 30)
     /// and angle (degrees, default 10), the least total fragment length of a fit (px, default
     /// 60), and a free number (a new value starts the tracking afresh from the same edges). Items: `[vanishing_u, vanishing_v, bottom_u, bottom_v, confidence, 0]` the
     /// centreline through the edges' vanishing point and the middle of the path at the window's

@@ -157,9 +157,12 @@ impl PathTracker {
     pub fn update(&mut self, lines: &[Line]) -> Option<PathFit> {
         let p = self.params;
         let wide = PathParams { max_distance_px: 2.0 * p.max_distance_px, max_angle: 2.0 * p.max_angle, ..p };
+        // A fit whose edges cross below the middle of the rows the path was last seen on is not
+        // the path ahead (taken as the next prediction, it would shut every fragment out).
+        let lowest = (self.horizon_v + self.bottom_v) / 2.0;
         let fit = [p, wide].into_iter().find_map(|q| {
             group(lines, &self.left, &self.right, self.horizon_v, self.bottom_v, &q)
-                .filter(|f| f.confidence >= p.min_confidence)
+                .filter(|f| f.confidence >= p.min_confidence && f.vanishing[1] < lowest)
         })?;
         // The vanishing point bounds the fragments of the next frame.
         (self.left, self.right, self.horizon_v) = (fit.left, fit.right, fit.vanishing[1]);

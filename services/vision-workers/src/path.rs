@@ -17,11 +17,14 @@ const MIN_GRADIENT: f32 = 8.0;
 /// 3.5): a gravel path's edge on a dim day steps little more than that.
 const NOISE_FACTOR: f32 = 1.2;
 
-/// One tracker per request id, with the parameters it was started from (a request of the id with
-/// other parameters starts afresh; one with another window goes on in the new window).
+/// What a tracker was started from: the request's parameters and the rows of its edges.
+type Started = ([f32; 8], [f32; 2]);
+
+/// One tracker per request id, with the parameters and rows it was started from (a request of the
+/// id with others starts afresh; one with another window goes on in the new window).
 #[derive(Debug, Default)]
 pub struct PathTrackers {
-    trackers: BTreeMap<u32, ([f32; 8], PathTracker)>,
+    trackers: BTreeMap<u32, (Started, PathTracker)>,
 }
 
 impl PathTrackers {
@@ -42,7 +45,11 @@ impl PathTrackers {
             max_angle: or(p[5], 10.0).to_radians(),
             min_confidence: or(p[6], 60.0),
         };
+        // The rows the predicted edges' columns are given at.
+        let rows = [req.expected.x_m as f32, req.expected.y_m as f32];
         let sane = p[..4].iter().all(|x| x.is_finite())
+            && rows.iter().all(|r| r.is_finite())
+            && rows[1] > rows[0]
             && params.max_distance_px > 0.0
             && params.max_distance_px < 1000.0
             && params.max_angle > 0.0
@@ -52,13 +59,16 @@ impl PathTrackers {
         if !sane {
             return Err(VisionStatus::BadParameter);
         }
+        let key = (*p, rows);
+        // The horizon of a level camera until a fit's vanishing point takes its place.
+        let horizon = img.height as f32 / 2.0;
         let fresh = |_: &u32| {
-            let left = ImageLine::through([p[0], top], [p[1], bottom]);
-            let right = ImageLine::through([p[2], top], [p[3], bottom]);
-            (*p, PathTracker::new(left, right, top, bottom, params))
+            let left = ImageLine::through([p[0], rows[0]], [p[1], rows[1]]);
+            let right = ImageLine::through([p[2], rows[0]], [p[3], rows[1]]);
+            (key, PathTracker::new(left, right, horizon, bottom, params))
         };
         let entry = self.trackers.entry(req.request_id).or_insert_with_key(fresh);
-        if entry.0 != *p {
+        if entry.0 != key {
             *entry = fresh(&req.request_id);
         }
         let tracker = &mut entry.1;
@@ -69,8 +79,6 @@ impl PathTrackers {
             ..FlfParams::default()
         };
         let lines = flf.lines(img, window, &flf_params).map_err(|e| crate::dispatch::status_of(&e))?;
-        // The horizon the tracker bounds fragments by never rises above the window.
-        tracker.horizon_v = tracker.horizon_v.max(top);
         if let Some(fit) = tracker.update(lines) {
             let c = fit.centreline;
             push([fit.vanishing[0], fit.vanishing[1], c.x_at(bottom), bottom, fit.confidence, 0.0]);

@@ -1,4 +1,3 @@
-#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 //! Class III landmarks on the floor (the campus path's edges against its lawns: ground lines
 //! with no wall) under the sweep's sensor conditions (nominal, dim, harsh), on rendered campus
 //! frames with the camera's noise, vignetting, blur and a misaligned mount: from seeded poses on
@@ -6,6 +5,7 @@
 //! degrees off the segment's), the recogniser (`landmarks::ground::GroundLines`) is given the
 //! window the UMS's Expecter would give for each of the segment's two edges, and its heading
 //! and offset are judged against the truth. Prints a table per condition, segment and surface.
+#![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 #[allow(dead_code, reason = "the hallway's `lit` is not this test's; its conditions are")]
 mod light;

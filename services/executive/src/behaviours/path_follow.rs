@@ -22,6 +22,8 @@ use crate::mission::PathGoal;
 const REQUEST_ID: u32 = 2;
 /// Odometry poses kept to place a fit where the robot was when its frame was taken (ns).
 const HISTORY_NS: u64 = 3_000_000_000;
+/// The fewest rows the window keeps above its bottom one near a bend.
+const MIN_ROWS: f64 = 16.0;
 /// Fits in a row whose width disagrees with the map before the tracker starts afresh.
 const MISFITS: u32 = 3;
 
@@ -136,6 +138,8 @@ impl PathFollow {
             request_id: REQUEST_ID,
             algorithm: VisionAlgorithm::Path as u32,
             standing: 1,
+            // The rows the edges are predicted at; the window's top may come down under them.
+            expected: Pose2 { x_m: top, y_m: bottom, heading_rad: 0.0 },
             window_px: [0.0, top as f32, (2.0 * self.view.cx) as f32, (bottom + 1.0) as f32],
             params: [
                 e[0] as f32,
@@ -233,6 +237,7 @@ impl PathFollow {
                     self.phase = Phase::Following;
                     self.transitions += 1;
                     (self.fitted_at_m, self.target, self.blind) = (self.travelled_m, None, false);
+                    self.misfits = 0;
                     self.request = self.bootstrap(believed, now);
                     self.standing = self.request;
                     return (0.0, 0.0);
@@ -288,7 +293,10 @@ impl PathFollow {
         self.blind = depth < self.g.least_depth_m;
         let Some(mut r) = self.standing else { return };
         let v = &self.view;
-        let top = (v.cy + v.focal_px * v.height_m / depth.max(1e-3)).max(self.rows.0).floor() as f32;
+        // At least a few rows above the bottom one, whatever the settings.
+        let lowest = self.rows.1 - MIN_ROWS;
+        let top =
+            (v.cy + v.focal_px * v.height_m / depth.max(1e-3)).clamp(self.rows.0, lowest).floor() as f32;
         if !self.blind && top > r.window_px[1] {
             (r.window_px[1], r.header.stamp_ns) = (top, now);
             (self.request, self.standing) = (Some(r), Some(r));
@@ -312,7 +320,11 @@ pub fn in_world(g: &PathGoal, w: &World) -> Result<PathFollow, String> {
     let segments = g
         .segments
         .iter()
-        .map(|[l, r]| Ok(Segment::between(edge(l)?, edge(r)?)))
+        .map(|[l, r]| {
+            let s = Segment::between(edge(l)?, edge(r)?);
+            let real = s.width_m > 0.0 && s.length_m() > 0.0;
+            real.then_some(s).ok_or_else(|| format!("{l} and {r} (edges a path lies between)"))
+        })
         .collect::<Result<_, String>>()?;
     Ok(PathFollow::new(g.clone(), view, (width, height), segments, w.start))
 }

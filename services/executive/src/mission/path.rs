@@ -77,6 +77,9 @@ pub(crate) fn check_path(p: &PathGoal) -> Result<(), &'static str> {
     if p.segments.is_empty() || p.segments.len() > MAX_SEGMENTS {
         return Err("segments lists no segment, or more than 1000");
     }
+    if p.below_horizon_px < 1.0 {
+        return Err("below_horizon_px must be at least 1: the horizon's row sees no ground");
+    }
     if p.speed_mps <= 0.0 || p.lookahead_m <= 0.0 || p.max_distance_px <= 0.0 || p.max_angle_deg <= 0.0 {
         return Err("speed_mps, lookahead_m, max_distance_px and max_angle_deg must be above zero");
     }
