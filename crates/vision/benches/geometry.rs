@@ -91,10 +91,12 @@ pub fn bench_depth(world: &World, first: &GrayBuf, size: &str, rows: &mut Vec<Ro
         focal_px: world.camera.focal_for(w) as f32,
         patch: 11,
         startup_reach_px: 40.0,
+        min_depth_m: 0.0,
         update_reach_px: 4.0,
         noise_px: 0.3,
         min_score: 0.97,
         recut_score: 0.995,
+        register_reach_px: 0.0,
         moravec: CORNERS,
     };
     let mut dfm = DepthFromMotion::new(p);

@@ -14,6 +14,12 @@ use crate::image::{Gray, GrayBuf, Rect, VisionError};
 use crate::moravec::{Moravec, MoravecParams};
 use crate::nc::{Correlator, Template};
 
+pub use crate::depth_ground::{obstacles, standing_off_floor};
+pub use crate::register::register;
+
+use crate::depth_fit::{add_sample, fit};
+use crate::depth_radial::{RADIAL_CANDIDATES, radially_distinct};
+
 /// Settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct DepthParams {
@@ -22,8 +28,11 @@ pub struct DepthParams {
     pub focal_px: f32,
     /// Side of the patch tracked by correlation (odd).
     pub patch: usize,
-    /// Start-up search: how far out along the radial line a point may move (pixels).
+    /// Start-up search: how far out along the radial line a point may move (pixels), and the
+    /// nearest depth it may have (m; 0: any): the search reaches no further out than a point
+    /// that near would move, so a look-alike further along the line is not taken for it.
     pub startup_reach_px: f32,
+    pub min_depth_m: f64,
     /// Update search: the window round the predicted position (pixels each way).
     pub update_reach_px: f32,
     /// Measurement noise of a matched position (pixels), weighting the fit.
@@ -32,6 +41,8 @@ pub struct DepthParams {
     pub min_score: f32,
     /// Below this score the patch is cut afresh from the current frame.
     pub recut_score: f32,
+    /// How far the frame's shift may be from the guess (pixels; 0: the guess is taken as it is).
+    pub register_reach_px: f32,
     pub moravec: MoravecParams,
 }
 
@@ -46,8 +57,9 @@ pub struct Track {
     pub depth: Option<(f32, f32)>,
     /// Frames it has been matched in.
     pub frames: usize,
-    /// Sums of the weighted fit of `1/r` against travel: Σw, ΣwT, ΣwT², Σw/r, ΣwT/r.
-    sums: [f64; 5],
+    /// Sums of the weighted fit of `1/r` against travel: Σw, ΣwT, ΣwT², Σw/r, ΣwT/r, Σw/r²,
+    /// and the samples' count.
+    sums: [f64; 7],
     patch: GrayBuf,
     /// Where the point was when the patch was cut.
     patch_at: [f32; 2],
@@ -63,6 +75,7 @@ pub struct DepthFromMotion {
     correlator: Correlator,
     template: Option<Template>,
     travelled_m: f64,
+    shift: [f32; 2],
 }
 
 impl DepthFromMotion {
@@ -74,6 +87,7 @@ impl DepthFromMotion {
             correlator: Correlator::default(),
             template: None,
             travelled_m: 0.0,
+            shift: [0.0, 0.0],
         }
     }
 
@@ -90,16 +104,26 @@ impl DepthFromMotion {
         let half = p.patch / 2;
         self.tracks.clear();
         self.travelled_m = travelled_m;
-        for c in self.moravec.corners(img, window, &p.moravec)? {
+        self.shift = [0.0, 0.0];
+        // More candidates than points: those on an edge running out from the FOE are dropped.
+        let wanted = p.moravec.max_corners;
+        let candidates = MoravecParams { max_corners: wanted.saturating_mul(RADIAL_CANDIDATES), ..p.moravec };
+        for c in self.moravec.corners(img, window, &candidates)? {
             let (x, y) = (c.x, c.y);
+            if self.tracks.len() >= wanted {
+                break;
+            }
             if x < half || y < half || x + half >= img.width || y + half >= img.height {
                 continue;
             }
             let at = [x as f32 + 0.5, y as f32 + 0.5];
+            if !radially_distinct(img, &p, at)? {
+                continue;
+            }
             let id = self.tracks.len();
             let patch = GrayBuf::default();
             let mut t =
-                Track { id, at, depth: None, frames: 1, sums: [0.0; 5], patch, patch_at: at, lost: false };
+                Track { id, at, depth: None, frames: 1, sums: [0.0; 7], patch, patch_at: at, lost: false };
             add_sample(&mut t.sums, &p, at, travelled_m);
             t.patch = cut(img, x, y, half)?;
             self.tracks.push(t);
@@ -110,7 +134,26 @@ impl DepthFromMotion {
     /// Update: the next frame, taken at travel `travelled_m` (metres along the axis since any
     /// fixed origin). Returns how many points are still tracked.
     pub fn update(&mut self, img: &Gray<'_>, travelled_m: f64) -> Result<usize, VisionError> {
+        self.update_registered(img, travelled_m, [0.0, 0.0])
+    }
+
+    /// [`Self::update`] on a frame shifted by about `guess_px` against the start-up frame (the
+    /// registration 001 §2.3 asks for: a camera that turned a little since start-up sees the
+    /// scene moved sideways by about `f` times the angle). With `register_reach_px` set, the
+    /// shift is measured within that reach of the guess: each point is matched in a window
+    /// widened by it, and the shift is the one that puts the matches back on their radial lines
+    /// ([`register`]). Points are kept, and their depths fitted, in the start-up frame's
+    /// coordinates; the search and the patches are in this one.
+    pub fn update_registered(
+        &mut self,
+        img: &Gray<'_>,
+        travelled_m: f64,
+        guess_px: [f32; 2],
+    ) -> Result<usize, VisionError> {
         let p = self.params;
+        if !guess_px.iter().all(|s| s.is_finite()) {
+            return Err(VisionError::BadParameter(format!("registration shift {guess_px:?}")));
+        }
         let step = travelled_m - self.travelled_m;
         if step.is_nan() || step <= 0.0 {
             return Err(VisionError::BadParameter(format!(
@@ -120,19 +163,14 @@ impl DepthFromMotion {
         }
         self.travelled_m = travelled_m;
         let half = p.patch / 2;
+        let reach = p.update_reach_px.max(2.0) + p.register_reach_px;
+        // Each live point's best match in this frame's coordinates (NaN: lost).
+        let mut matched = Vec::with_capacity(self.tracks.len());
         for t in self.tracks.iter_mut().filter(|t| !t.lost) {
-            let (d, r) = radial(&p, t.at);
-            // Where the point must be: from its depth, or anywhere out along its ray at start-up.
-            let (lo, hi) = match t.depth {
-                Some((z, _)) if f64::from(z) > step => {
-                    let r_next = r * z / (z - step as f32);
-                    (r_next - p.update_reach_px, r_next + p.update_reach_px)
-                }
-                _ => (r, r + p.startup_reach_px),
-            };
-            let pt = |rr: f32| [p.foe[0] + d[0] * rr, p.foe[1] + d[1] * rr];
+            let (lo, hi) = expected_radii(&p, t, step);
+            let (d, _) = radial(&p, t.at);
+            let pt = |rr: f32| [p.foe[0] + d[0] * rr + guess_px[0], p.foe[1] + d[1] * rr + guess_px[1]];
             let (a, b) = (pt(lo.max(0.0)), pt(hi));
-            let reach = p.update_reach_px.max(2.0);
             let x0 = a[0].min(b[0]) - reach - half as f32;
             let y0 = a[1].min(b[1]) - reach - half as f32;
             let x1 = a[0].max(b[0]) + reach + half as f32 + 1.0;
@@ -148,14 +186,35 @@ impl DepthFromMotion {
             }
             let Some(tm) = self.template.as_ref() else { continue };
             let m = self.correlator.best(img, win, tm)?;
+            if m.score < p.min_score {
+                t.lost = true;
+                continue;
+            }
             // The patch was cut centred on the pixel holding the point: keep its offset.
             let pa = t.patch_at;
             let off = [pa[0] - (pa[0] - 0.5).round() - 0.5, pa[1] - (pa[1] - 0.5).round() - 0.5];
-            let at = [m.centre[0] + off[0], m.centre[1] + off[1]];
-            // A static point stays on its radial line.
+            matched.push((t.id, [m.centre[0] + off[0], m.centre[1] + off[1]], m.score));
+        }
+        let shift = if p.register_reach_px > 0.0 {
+            let lines: Vec<([f32; 2], [f32; 2])> = matched
+                .iter()
+                .map(|&(id, at, _)| (radial(&p, self.tracks[id].at).0, [at[0] - p.foe[0], at[1] - p.foe[1]]))
+                .collect();
+            register(&lines, guess_px, p.register_reach_px)
+        } else {
+            guess_px
+        };
+        self.shift = shift;
+        for (id, here, score) in matched {
+            let Some(t) = self.tracks.get_mut(id) else { continue };
+            let at = [here[0] - shift[0], here[1] - shift[1]];
+            // A static point stays on its radial line, moving out as far as its depth says.
+            let (d, r) = radial(&p, t.at);
+            let (lo, hi) = expected_radii(&p, t, step);
             let (_, r_new) = radial(&p, at);
             let across = (at[0] - p.foe[0]) * d[1] - (at[1] - p.foe[1]) * d[0];
-            if m.score < p.min_score || across.abs() > 1.5 || r_new <= r {
+            let slack = p.update_reach_px.max(2.0);
+            if across.abs() > 1.5 || r_new <= r || r_new < lo - slack || r_new > hi + slack {
                 t.lost = true;
                 continue;
             }
@@ -164,22 +223,47 @@ impl DepthFromMotion {
             add_sample(&mut t.sums, &p, at, travelled_m);
             t.depth = fit(&t.sums, travelled_m);
             // Keep the patch while it still matches well: every re-cut adds a little drift.
-            if m.score < p.recut_score {
-                let (cx, cy) = ((at[0] - 0.5).round() as usize, (at[1] - 0.5).round() as usize);
-                if cx < half || cy < half || cx + half >= img.width || cy + half >= img.height {
+            if score < p.recut_score {
+                let (cx, cy) = ((here[0] - 0.5).round(), (here[1] - 0.5).round());
+                let fits = |c: f32, n: usize| c >= half as f32 && c + (half as f32) < n as f32;
+                if !fits(cx, img.width) || !fits(cy, img.height) {
                     t.lost = true;
                     continue;
                 }
+                let (cx, cy) = (cx as usize, cy as usize);
                 t.patch.crop_from(img, Rect::new(cx - half, cy - half, cx + half + 1, cy + half + 1))?;
-                t.patch_at = at;
+                t.patch_at = here;
             }
         }
         Ok(self.tracks().count())
     }
+
+    /// The shift the last update registered its frame by (px).
+    pub fn shift(&self) -> [f32; 2] {
+        self.shift
+    }
+}
+
+/// How far from the FOE `t` may be after a further `step` of travel: round where its depth puts
+/// it, or anywhere out along its ray before it has a depth.
+fn expected_radii(p: &DepthParams, t: &Track, step: f64) -> (f32, f32) {
+    let (_, r) = radial(p, t.at);
+    match t.depth {
+        Some((z, _)) if f64::from(z) > step => {
+            let r_next = r * z / (z - step as f32);
+            (r_next - p.update_reach_px, r_next + p.update_reach_px)
+        }
+        // Nothing nearer than `min_depth_m` moves further out than that depth allows.
+        _ if p.min_depth_m > step => {
+            let near = (f64::from(r) * step / (p.min_depth_m - step)) as f32;
+            (r, r + near.min(p.startup_reach_px))
+        }
+        _ => (r, r + p.startup_reach_px),
+    }
 }
 
 /// Unit direction from the FOE to `at`, and the distance.
-fn radial(p: &DepthParams, at: [f32; 2]) -> ([f32; 2], f32) {
+pub(crate) fn radial(p: &DepthParams, at: [f32; 2]) -> ([f32; 2], f32) {
     let (dx, dy) = (at[0] - p.foe[0], at[1] - p.foe[1]);
     let r = dx.hypot(dy).max(1e-3);
     ([dx / r, dy / r], r)
@@ -187,129 +271,4 @@ fn radial(p: &DepthParams, at: [f32; 2]) -> ([f32; 2], f32) {
 
 fn cut(img: &Gray<'_>, x: usize, y: usize, half: usize) -> Result<GrayBuf, VisionError> {
     GrayBuf::crop(img, Rect::new(x - half, y - half, x + half + 1, y + half + 1))
-}
-
-/// Adds a sample `(T, 1/r)` weighted by `1 / var(1/r) = r⁴ / σ²`.
-fn add_sample(s: &mut [f64; 5], p: &DepthParams, at: [f32; 2], travelled_m: f64) {
-    let (_, r) = radial(p, at);
-    let r = f64::from(r);
-    let w = r.powi(4) / f64::from(p.noise_px).powi(2);
-    let (t, y) = (travelled_m, 1.0 / r);
-    for (k, v) in [w, w * t, w * t * t, w * y, w * t * y].into_iter().enumerate() {
-        s[k] += v;
-    }
-}
-
-/// Depth now and its standard deviation from the weighted line `1/r = a + b T`:
-/// `Z0 = -a / b`, now `Z0 - T`, with the variance propagated from the fit's covariance.
-fn fit(s: &[f64; 5], now: f64) -> Option<(f32, f32)> {
-    let [sw, st, stt, sy, sty] = *s;
-    let det = sw * stt - st * st;
-    if det <= 0.0 {
-        return None;
-    }
-    let b = (sw * sty - st * sy) / det;
-    let a = (sy - b * st) / sw;
-    if b >= 0.0 {
-        return None;
-    }
-    // Covariance of (a, b): the inverse of [[Σw, ΣwT], [ΣwT, ΣwT²]].
-    let (vaa, vbb, vab) = (stt / det, sw / det, -st / det);
-    let z0 = -a / b;
-    // dZ0/da = -1/b, dZ0/db = a/b².
-    let (ga, gb) = (-1.0 / b, a / (b * b));
-    let var = ga * ga * vaa + gb * gb * vbb + 2.0 * ga * gb * vab;
-    Some(((z0 - now) as f32, var.max(0.0).sqrt() as f32))
-}
-
-/// Obstacle extraction: fits image row against `1/depth` over the tracked points below the
-/// FOE (robustly: refits without the worst point while any lies off by more than the
-/// tolerance), and returns, for each track, whether it stands off the ground line (`None`:
-/// its depth is not yet known to better than `max_rel_sd`). The tolerance is `tol_px` plus
-/// `tol_frac` of the point's height below the FOE in the image, as depth errors are relative.
-pub fn obstacles(
-    tracks: &[&Track],
-    foe_v: f32,
-    tol_px: f32,
-    tol_frac: f32,
-    max_rel_sd: f32,
-) -> Vec<Option<bool>> {
-    let tol = |v: f64| f64::from(tol_px) + f64::from(tol_frac) * (v - f64::from(foe_v)).max(0.0);
-    let pts: Vec<(usize, f64, f64)> = tracks
-        .iter()
-        .enumerate()
-        .filter_map(|(i, t)| {
-            let known = t.depth.filter(|(z, sd)| *z > 0.0 && *sd <= max_rel_sd * *z);
-            known.map(|(z, _)| (i, 1.0 / f64::from(z), f64::from(t.at[1])))
-        })
-        .collect();
-    let mut ground: Vec<(usize, f64, f64)> = pts.iter().copied().filter(|p| p.2 > f64::from(foe_v)).collect();
-    let mut line = (0.0, 0.0);
-    while ground.len() >= 3 {
-        let n = ground.len() as f64;
-        let (sx, sy) = ground.iter().fold((0.0, 0.0), |a, p| (a.0 + p.1, a.1 + p.2));
-        let (sxx, sxy) = ground.iter().fold((0.0, 0.0), |a, p| (a.0 + p.1 * p.1, a.1 + p.1 * p.2));
-        let slope = (n * sxy - sx * sy) / (n * sxx - sx * sx);
-        line = ((sy - slope * sx) / n, slope);
-        let worst = ground
-            .iter()
-            .enumerate()
-            .map(|(k, p)| (k, (p.2 - line.0 - line.1 * p.1).abs() / tol(line.0 + line.1 * p.1)))
-            .max_by(|a, b| a.1.total_cmp(&b.1));
-        match worst {
-            Some((k, e)) if e > 1.0 => {
-                ground.swap_remove(k);
-            }
-            _ => break,
-        }
-    }
-    let mut out = vec![None; tracks.len()];
-    for (i, x, v) in pts {
-        let ground_v = line.0 + line.1 * x;
-        out[i] = Some(v < ground_v - tol(ground_v));
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn exact_radial_positions_give_the_exact_depth_and_a_shrinking_spread() {
-        let p = DepthParams {
-            foe: [320.0, 240.0],
-            focal_px: 500.0,
-            patch: 11,
-            startup_reach_px: 30.0,
-            update_reach_px: 3.0,
-            noise_px: 0.5,
-            min_score: 0.9,
-            recut_score: 0.99,
-            moravec: MoravecParams::default(),
-        };
-        // A point 12 m ahead, 0.8 m left and 0.5 m down of the axis.
-        let (z0, lateral) = (12.0f64, [0.8f64, 0.5]);
-        let mut sums = [0.0; 5];
-        let mut spreads = Vec::new();
-        for k in 0..6 {
-            let t = 0.5 * k as f64;
-            let at = [
-                320.0 + (500.0 * lateral[0] / (z0 - t)) as f32,
-                240.0 + (500.0 * lateral[1] / (z0 - t)) as f32,
-            ];
-            add_sample(&mut sums, &p, at, t);
-            if let Some((z, sd)) = fit(&sums, t) {
-                assert!((f64::from(z) - (z0 - t)).abs() < 1e-3 * z0, "frame {k}: {z} vs {}", z0 - t);
-                spreads.push(sd);
-            }
-        }
-        assert_eq!(spreads.len(), 5);
-        assert!(spreads.windows(2).all(|w| w[1] < w[0]), "{spreads:?}");
-        // A point that does not move away from the FOE has no depth.
-        let mut still = [0.0; 5];
-        add_sample(&mut still, &p, [400.0, 300.0], 0.0);
-        add_sample(&mut still, &p, [400.0, 300.0], 0.5);
-        assert_eq!(fit(&still, 0.5), None);
-    }
 }
