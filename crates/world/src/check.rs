@@ -52,7 +52,9 @@ pub enum Inconsistency {
     MoverShape { mover: String },
     #[error("mover {mover}: path times must increase")]
     MoverTimes { mover: String },
-    #[error("mover {mover}: height must be positive, reflectance in 0..=1")]
+    #[error(
+        "mover {mover}: height must be positive, reflectances in 0..=1, bands `[from_m, to_m, reflectance]` rising within its height"
+    )]
     MoverLook { mover: String },
 }
 

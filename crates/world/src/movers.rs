@@ -22,6 +22,10 @@ pub struct Mover {
     /// `[t_s, x_m, y_m]`: where the reference point is at simulated time `t_s`; in between it
     /// moves in a straight line, before the first and after the last it stands still.
     pub path: Vec<[f64; 3]>,
+    /// Horizontal bands painted round it (a traffic cone's reflective collar, a box's tape):
+    /// `[from_m, to_m, reflectance]`, heights above the floor.
+    #[serde(default)]
+    pub bands: Vec<[f64; 3]>,
 }
 
 impl Mover {
@@ -80,7 +84,13 @@ pub fn parse_movers(text: &str, file: &str) -> Result<Vec<Mover>, WorldError> {
         if m.path.windows(2).any(|w| w[1][0] <= w[0][0]) {
             return Err(bad(Inconsistency::MoverTimes { mover: m.name.clone() }));
         }
-        if m.height_m.is_nan() || m.height_m <= 0.0 || !(0.0..=1.0).contains(&m.reflectance) {
+        let band_fits =
+            |b: &[f64; 3]| 0.0 <= b[0] && b[0] < b[1] && b[1] <= m.height_m && (0.0..=1.0).contains(&b[2]);
+        if m.height_m.is_nan()
+            || m.height_m <= 0.0
+            || !(0.0..=1.0).contains(&m.reflectance)
+            || !m.bands.iter().all(band_fits)
+        {
             return Err(bad(Inconsistency::MoverLook { mover: m.name.clone() }));
         }
     }
@@ -95,6 +105,7 @@ fn check_mover(k: &KeyPath, m: &Mover) -> Result<(), OutOfRange> {
     }
     check(&k.key("height_m"), m.height_m, &Range::above(0.0, 100.0, "m"))?;
     check(&k.key("reflectance"), m.reflectance, &FRACTION)?;
+    check_len(&k.key("bands"), m.bands.len(), MAX_CORNERS, "bands")?;
     check_len(&k.key("path"), m.path.len(), MAX_WAYPOINTS, "waypoints")?;
     for (i, [t, x, y]) in m.path.iter().enumerate() {
         let p = k.key("path").index(i);
@@ -134,13 +145,24 @@ impl World {
             let n = m.outline.len();
             for k in 0..n {
                 let (a, b) = (m.outline[k], m.outline[(k + 1) % n]);
+                let length = (b[0] - a[0]).hypot(b[1] - a[1]);
+                let regions = m
+                    .bands
+                    .iter()
+                    .map(|&[lo, hi, reflectance]| crate::Region {
+                        along_m: [0.0, length],
+                        height_m: [lo, hi],
+                        reflectance,
+                        colour: [1.0, 1.0, 1.0],
+                    })
+                    .collect();
                 self.walls.push(Wall {
                     from: [x + a[0], y + a[1]],
                     to: [x + b[0], y + b[1]],
                     height_m: m.height_m,
                     reflectance: m.reflectance,
                     colour: [1.0, 1.0, 1.0],
-                    regions: Vec::new(),
+                    regions,
                 });
             }
         }

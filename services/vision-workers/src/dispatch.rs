@@ -17,6 +17,7 @@ use harvey_vision::nc::{Correlator, Template};
 use harvey_vision::{Gray, GrayBuf, Rect, VisionError};
 use harvey_world::World;
 
+use crate::depth::DepthTrackers;
 use crate::odometry::{Odometries, Outcome};
 use crate::odometry_config::OdometryConfig;
 use crate::path::PathTrackers;
@@ -41,6 +42,8 @@ pub struct Dispatcher {
     odometries: Odometries,
     /// Path following keeps a tracker per (standing) request.
     paths: PathTrackers,
+    /// Depth from motion likewise.
+    depths: DepthTrackers,
     seq: u64,
 }
 
@@ -97,6 +100,7 @@ impl Dispatcher {
             poles: Vec::new(),
             odometries: Odometries::default(),
             paths: PathTrackers::default(),
+            depths: DepthTrackers::default(),
             seq: 0,
         }
     }
@@ -278,6 +282,10 @@ impl Dispatcher {
                 }
             }
             VisionAlgorithm::Path => self.paths.answer(&mut self.flf, &img, window, req, &mut push)?,
+            VisionAlgorithm::Depth => {
+                let camera = (self.world.camera.focal_for(w as u32), self.world.camera.height_m);
+                self.depths.answer(&img, window, camera, req, &mut push)?;
+            }
             VisionAlgorithm::StereoOdometry => {
                 let outcome = self.odometries.answer(&self.world, h, pixels, req, &mut push)?;
                 return Ok(outcome == Outcome::NoSolution);

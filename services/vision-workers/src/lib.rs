@@ -5,6 +5,7 @@ pub mod node;
 use harvey_msgs::{Detections, Feature, FrameHeader, Header, MAX_FEATURES};
 
 /// Algorithm ids carried in [`Detections::algorithm`].
+pub mod depth;
 pub mod dispatch;
 pub mod landmarks;
 pub mod odometry;

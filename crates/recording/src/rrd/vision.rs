@@ -1,6 +1,7 @@
 //! How vision results are drawn on the camera image: lines, corners, region centroids, the dock,
 //! poles, correlation matches (a line from where the vertex was expected to where it was
-//! found), the path's edges and centreline and the stereo odometry's obstacle points, one entity per request, taken off once stale; labels only where a result has a few
+//! found), the path's edges and centreline, the stereo odometry's obstacle points and depth from
+//! motion's tracked points, one entity per request, taken off once stale; labels only where a result has a few
 //! items; the light blob's size as a plot; failed requests go to the log.
 
 use harvey_msgs::{VisionAlgorithm, VisionResult, VisionStatus};
@@ -134,6 +135,30 @@ impl RrdWriter {
                     .collect();
                 let drawn =
                     rerun::Points2D::new(pts).with_labels(labels).with_radii([3.0]).with_colors([colour]);
+                self.rec.log(path.as_str(), &drawn)
+            }
+            Some(VisionAlgorithm::Depth) => {
+                // Each tracked point (after the registration's item), labelled with its depth and
+                // spread (the nearest few); those standing off the floor are the obstacles.
+                let items = items.get(1..).unwrap_or_default();
+                let pts: Vec<[f32; 2]> = items.iter().map(|i| [i.values[0], i.values[1]]).collect();
+                let labels: Vec<String> = items
+                    .iter()
+                    .enumerate()
+                    .map(|(k, i)| {
+                        let v = i.values;
+                        let kind = if v[5] > 0.5 { " obstacle" } else { "" };
+                        if k < LABELLED {
+                            format!("{:.2} ± {:.2} m{kind}", v[2], v[3])
+                        } else {
+                            String::new()
+                        }
+                    })
+                    .collect();
+                let radii: Vec<f32> =
+                    items.iter().map(|i| if i.values[5] > 0.5 { 4.0 } else { 2.0 }).collect();
+                let drawn =
+                    rerun::Points2D::new(pts).with_labels(labels).with_radii(radii).with_colors([colour]);
                 self.rec.log(path.as_str(), &drawn)
             }
             None => return Ok(()),
