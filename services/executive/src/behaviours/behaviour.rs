@@ -1,6 +1,7 @@
 //! The acceptor-sequenced behaviours a mission may run instead of a script or a plan (004):
 //! docking and the pole hunt, CMU's stop-go-stop navigation (003) and door finding by sonar
-//! (001 §3.2) and path following (001 §2.1), behind one face, and
+//! (001 §3.2), path following (001 §2.1) and obstacle avoidance by depth from motion (001 §2.3),
+//! behind one face, and
 //! run as the executive's mode.
 
 use harvey_msgs::{
@@ -8,6 +9,7 @@ use harvey_msgs::{
     VisionRequest, VisionResult,
 };
 
+use super::depth_obstacles::DepthObstacles;
 use super::docking::Docking;
 use super::door_finding::DoorFinding;
 use super::neptune::Neptune;
@@ -22,6 +24,7 @@ pub enum Behaviour {
     Neptune(Box<Neptune>),
     Door(Box<DoorFinding>),
     Path(Box<PathFollow>),
+    Depth(Box<DepthObstacles>),
 }
 
 impl Behaviour {
@@ -31,6 +34,7 @@ impl Behaviour {
             Self::Poles(p) => p.on_sonar(r),
             Self::Neptune(n) => n.on_sonar(r),
             Self::Door(d) => d.on_sonar(r),
+            Self::Depth(d) => d.on_sonar(r),
             Self::Path(_) => {}
         }
     }
@@ -51,6 +55,7 @@ impl Behaviour {
             Self::Poles(p) => p.on_vision(r),
             Self::Neptune(n) => n.on_vision(r),
             Self::Path(p) => p.on_vision(r),
+            Self::Depth(d) => d.on_vision(r),
             Self::Door(_) => {}
         }
     }
@@ -66,6 +71,7 @@ impl Behaviour {
             Self::Poles(p) => p.on_odometry(odometry, now),
             Self::Neptune(n) => n.on_odometry(odometry, now),
             Self::Path(p) => p.on_odometry(odometry, now),
+            Self::Depth(d) => d.on_odometry(odometry, now),
             Self::Door(d) => {
                 let (command, state) = d.on_odometry(odometry, now);
                 (None, command, state)
@@ -81,13 +87,14 @@ impl Behaviour {
             Self::Neptune(n) => n.done,
             Self::Door(d) => d.done,
             Self::Path(p) => p.done,
+            Self::Depth(d) => d.done,
         }
     }
 
     /// Whether the mission counts as succeeded if its time runs out now.
     pub fn enough_at_timeout(&self) -> bool {
         match self {
-            Self::Docking(_) | Self::Neptune(_) | Self::Door(_) | Self::Path(_) => false,
+            Self::Docking(_) | Self::Neptune(_) | Self::Door(_) | Self::Path(_) | Self::Depth(_) => false,
             Self::Poles(p) => p.enough(),
         }
     }
@@ -98,6 +105,7 @@ impl Behaviour {
             Self::Docking(d) => d.believed(),
             Self::Neptune(n) => n.believed(),
             Self::Path(p) => p.believed(),
+            Self::Depth(d) => d.believed(),
             Self::Poles(_) | Self::Door(_) => odometry,
         }
     }
@@ -109,6 +117,7 @@ impl Behaviour {
             Self::Neptune(n) => n.goal_pose(),
             Self::Door(d) => d.goal_pose(),
             Self::Path(p) => p.goal_pose(),
+            Self::Depth(d) => d.goal_pose(),
         }
     }
 }

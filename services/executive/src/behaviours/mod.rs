@@ -10,6 +10,8 @@
 //! by the line finder (001 §2.1, `path_follow.rs`, the camera's view of the path in `path_view.rs`).
 
 pub mod behaviour;
+mod depth_look;
+pub mod depth_obstacles;
 pub mod dock_pose;
 pub mod docking;
 pub mod door_finding;

@@ -93,6 +93,9 @@ pub(crate) fn check_bounds(m: &Mission) -> Result<(), OutOfRange> {
     if let Some(p) = &m.path {
         super::path::check_bounds(&root("path"), p)?;
     }
+    if let Some(d) = &m.depth {
+        super::depth::check_bounds(&root("depth"), d)?;
+    }
     Ok(())
 }
 

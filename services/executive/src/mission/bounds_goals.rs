@@ -33,7 +33,7 @@ pub(crate) const GAIN: Range = Range::closed(0.0, 10.0, "m/s");
 pub(crate) const TURN_RATE: Range = Range::above(0.0, 360.0, "deg/s");
 pub(crate) const TURN_GAIN: Range = Range::above(0.0, 100.0, "per s");
 /// Waits that may be zero: no longer than the longest mission.
-const WAIT: Range = Range::closed(0.0, TIMEOUT.hi, "s");
+pub(crate) const WAIT: Range = Range::closed(0.0, TIMEOUT.hi, "s");
 /// Counts of ticks (a fix's period, the noise's persistence): up to a million, more than a
 /// day-long mission has at 10 Hz; a tick counter never overflows.
 const MAX_TICKS: u32 = 1_000_000;

@@ -8,11 +8,13 @@ use serde::Deserialize;
 
 mod bounds;
 mod bounds_goals;
+pub mod depth;
 pub mod door;
 mod error;
 pub mod goals;
 pub mod path;
 
+pub use depth::DepthGoal;
 pub use door::{DoorGoal, DoorVariant, Side};
 pub use error::MissionError;
 pub use goals::{DockingGoal, NeptuneGoal, PolesGoal, PtransGoal};
@@ -119,6 +121,7 @@ pub struct Mission {
     pub neptune: Option<NeptuneGoal>,
     pub door: Option<DoorGoal>,
     pub path: Option<PathGoal>,
+    pub depth: Option<DepthGoal>,
 }
 
 #[derive(Deserialize)]
@@ -152,7 +155,8 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
         + usize::from(m.poles.is_some())
         + usize::from(m.neptune.is_some())
         + usize::from(m.door.is_some())
-        + usize::from(m.path.is_some());
+        + usize::from(m.path.is_some())
+        + usize::from(m.depth.is_some());
     match (behaviours, m.steps.is_empty()) {
         (0, true) => return Err(MissionError::NothingToDo { file: file_name() }),
         (1, true) | (0, false) => {}
@@ -176,6 +180,9 @@ pub fn parse(text: &str, file: &str) -> Result<Mission, MissionError> {
     }
     if let Some(p) = &m.path {
         path::check_path(p).map_err(|what| goal("path", what))?;
+    }
+    if let Some(d) = &m.depth {
+        depth::check_depth(d).map_err(|what| goal("depth", what))?;
     }
     for (index, s) in m.steps.iter().enumerate() {
         match (s.move_m, s.turn_deg, s.refine_pose) {
