@@ -83,22 +83,24 @@ pub enum VisionAlgorithm {
     /// direction in radians). `NotFound`: no confident fit (the prediction is kept).
     Path = 10,
     /// Depth from motion and obstacle extraction (001 §2.3, Table 1), as a sequence of one-off
-    /// requests of one id, one per frame of a straight run: the first (or one whose
-    /// `params[0]` differs from the last) starts afresh with the Moravec points of the window;
+    /// requests of one id, one per frame of a straight run: the first (travel 0, or any whose
+    /// parameters differ from the last) starts afresh with the Moravec points of the window;
     /// each later one tracks them along their radial lines from the focus of expansion (the
     /// image's centre: the camera translates along its axis) and refits each point's depth.
     /// `expected`: `x_m` the travel along the axis since the first frame (m, from the
-    /// odometry; it must grow), `heading_rad` the camera's turn since then (rad, left positive:
-    /// the worker registers the frame within a few pixels of the shift it gives). params: a free
-    /// number (a new value starts afresh), the least correlation score of a match (default 0.9),
-    /// the Moravec threshold (3000), most points (60), the position noise (px, 0.5), the least
-    /// height above the floor of an obstacle (m, 0.1; by the world's camera height), unused, and
-    /// the largest relative spread of a depth judged (0.1). Items: `[shift_u, shift_v, tracked,
-    /// with_depth, 0, 0]`, the shift this frame was registered by against the first (px; the
-    /// camera's true turn since then is `atan(shift_u / f)`, a visual compass) and the counts
-    /// of points (zeros but `tracked` at the first frame), then each point with a depth,
-    /// nearest first: `[u, v, depth_m, sd_m, frames, class]`, `u, v` where it is in this frame,
-    /// `class` 1 standing off the floor, 0 on it, -1 not judged.
+    /// odometry; it must grow), `heading_rad` the camera's turn since then (rad, left positive):
+    /// the worker registers the frame within 10 px of the last frame's shift moved on by that
+    /// turn's. params: a free number (a new value starts afresh), the least correlation score
+    /// of a match (default 0.9), the Moravec threshold (3000), most points (60), the position
+    /// noise (px, 0.5), the least height above the floor of an obstacle (m, 0.1; by the world's
+    /// camera height), unused, and the largest relative spread of a depth judged (0.1). Items:
+    /// `[shift_u, shift_v, tracked, with_depth, number, travel_m]`, the shift this frame was
+    /// registered by against the first (px; the camera's true turn since then is `atan(shift_u
+    /// / f)`, a visual compass), the counts of points (zeros but `tracked` at the first frame)
+    /// and the request's free number and travel echoed; then each point with a depth, those
+    /// standing off the floor first, each kind nearest first: `[u, v, depth_m, sd_m, frames,
+    /// class]`, `u, v` where it is in this frame, `class` 1 standing off the floor, 0 on it, -1
+    /// not judged. `NotFound`: a later frame of a run the worker does not hold (it restarted).
     Depth = 11,
 }
 

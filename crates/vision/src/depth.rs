@@ -51,7 +51,7 @@ pub struct DepthParams {
 pub struct Track {
     /// Its number at start-up.
     pub id: usize,
-    /// Image position now.
+    /// Image position now, in the start-up frame's coordinates (a registered frame shifted back).
     pub at: [f32; 2],
     /// Depth now along the optical axis (m) and its standard deviation; `None` before two frames.
     pub depth: Option<(f32, f32)>,
@@ -164,7 +164,7 @@ impl DepthFromMotion {
         self.travelled_m = travelled_m;
         let half = p.patch / 2;
         let reach = p.update_reach_px.max(2.0) + p.register_reach_px;
-        // Each live point's best match in this frame's coordinates (NaN: lost).
+        // Each live point's best match in this frame's coordinates.
         let mut matched = Vec::with_capacity(self.tracks.len());
         for t in self.tracks.iter_mut().filter(|t| !t.lost) {
             let (lo, hi) = expected_radii(&p, t, step);

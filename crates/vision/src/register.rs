@@ -6,8 +6,9 @@
 /// was) and its place `m` relative to the FOE in this frame, the shift `s` (within `reach` of
 /// `guess`) that puts the matches back on their lines, `d × (m - s) = 0`, by least squares,
 /// refitted without matches left more than 1.5 px off (a mismatch, a thing that moved). Points
-/// spread round the FOE tie both directions down; with fewer than four matches, or all along
-/// one direction, the guess stands.
+/// spread round the FOE tie both directions down; with fewer than four matches, all along one
+/// direction, or a solution beyond the reach, the last refit's shift stands (the guess, if
+/// none was made).
 pub fn register(lines: &[([f32; 2], [f32; 2])], guess: [f32; 2], reach: f32) -> [f32; 2] {
     let mut keep: Vec<bool> = vec![true; lines.len()];
     let mut shift = guess;

@@ -53,8 +53,8 @@ fn or(v: f32, default: f32) -> f32 {
 
 impl DepthTrackers {
     /// Starts or goes on with `req`'s run on `img` (the camera's focal length and height above
-    /// the floor, `camera`): the registration and counts, then the tracked points' items,
-    /// nearest first, through `push`.
+    /// the floor, `camera`): the registration and counts, then the tracked points' items
+    /// (standing off the floor first, each kind nearest first), through `push`.
     pub fn answer(
         &mut self,
         img: &Gray<'_>,
@@ -101,11 +101,16 @@ impl DepthTrackers {
             None => true,
         };
         if fresh {
+            // A run's first look is at travel 0: a later one for a run this worker does not hold
+            // (it restarted meanwhile) cannot go on, and says so.
+            if travelled != 0.0 {
+                return Err(VisionStatus::NotFound);
+            }
             let mut dfm = DepthFromMotion::new(params);
             let started = dfm.start(img, window, travelled).map_err(|e| status_of(&e))?;
             let run = Run { generation: p[0], travelled_m: travelled, turned_rad: turned, dfm };
             self.runs.insert(req.request_id, run);
-            push([0.0, 0.0, started as f32, 0.0, 0.0, 0.0]);
+            push([0.0, 0.0, started as f32, 0.0, p[0], travelled as f32]);
             return Ok(());
         }
         let Some(run) = self.runs.get_mut(&req.request_id) else { return Err(VisionStatus::BadParameter) };
@@ -142,9 +147,10 @@ impl DepthTrackers {
                 Some([t.at[0] + shift[0], t.at[1] + shift[1], z, sd, t.frames as f32, class])
             })
             .collect();
-        items.sort_by(|a, b| a[2].total_cmp(&b[2]));
+        // Those standing off the floor first (a result holds 32 items), each kind nearest first.
+        items.sort_by(|a, b| b[5].total_cmp(&a[5]).then(a[2].total_cmp(&b[2])));
         let live = run.dfm.tracks().count();
-        push([shift[0], shift[1], live as f32, items.len() as f32, 0.0, 0.0]);
+        push([shift[0], shift[1], live as f32, items.len() as f32, p[0], travelled as f32]);
         items.into_iter().for_each(push);
         Ok(())
     }

@@ -40,7 +40,8 @@ enum Phase {
 
 /// A straight run: where its first look was taken (odometry), its number (the request's first
 /// parameter), its looks so far, the turn the camera made since its start that the odometry
-/// did not count (rad, as of the last look) and where the robot was believed to be then.
+/// did not count (rad, as of the last look) and where the robot was believed to be then, and
+/// the look last asked (its answer echoes the number and travel).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Run {
     start: Pose2,
@@ -48,11 +49,12 @@ struct Run {
     looks: u32,
     unseen_turn: f64,
     last_look: Pose2,
+    asked: Option<Look>,
 }
 
 impl Run {
     fn new(start: Pose2, number: u32, believed: Pose2) -> Self {
-        Self { start, number, looks: 0, unseen_turn: 0.0, last_look: believed }
+        Self { start, number, looks: 0, unseen_turn: 0.0, last_look: believed, asked: None }
     }
 }
 
@@ -97,7 +99,11 @@ impl DepthObstacles {
     pub fn new(g: DepthGoal, camera: [f64; 4], robot_radius_m: f64, start: Pose2) -> Self {
         let [focal_px, width_px, height_px, height_m] = camera;
         let floor_row = height_px / 2.0 + focal_px * height_m / (2.0 * g.max_range_m);
+        // Within the image, whatever the table says.
         let mut window_px = g.window_px;
+        window_px[2] = window_px[2].min(width_px);
+        window_px[3] = window_px[3].min(height_px);
+        window_px[0] = window_px[0].min(window_px[2] - 1.0);
         window_px[1] = window_px[1].max(floor_row.floor()).min(window_px[3] - 1.0);
         Self {
             window_px,
@@ -152,7 +158,16 @@ impl DepthObstacles {
         self.looks += 1;
         self.run.looks += 1;
         let items = &r.items[..(r.count as usize).min(r.items.len())];
-        match (VisionStatus::from_raw(r.status), items.split_first()) {
+        let status = VisionStatus::from_raw(r.status);
+        // A found answer to another look (a late one of the run before) is not this look's.
+        if let (Some(VisionStatus::Found), Some(first), Some(asked)) = (status, items.first(), self.run.asked)
+        {
+            let [.., number, travel] = first.values.map(f64::from);
+            if number != f64::from(asked.number as f32) || (travel - asked.travelled_m).abs() > 1e-3 {
+                return;
+            }
+        }
+        match (status, items.split_first()) {
             (Some(VisionStatus::Found), Some((registration, points))) => {
                 let [shift_u, ..] = registration.values.map(f64::from);
                 self.register((shift_u / self.focal_px).atan());
@@ -269,12 +284,20 @@ impl DepthObstacles {
             }
             Phase::Settling { since_ns: Some(t) } => {
                 if now >= t + (g.settle_s * 1e9) as u64 {
+                    // A step the robot barely made (a reflex held it) moves the points too
+                    // little to measure: a new run starts here.
+                    let last = self.run.asked.map_or(0.0, |a| a.travelled_m);
+                    if self.run.looks > 0 && self.travelled() - last < g.step_m / 2.0 {
+                        self.run.number += 1;
+                        self.run.looks = 0;
+                    }
                     if self.run.looks == 0 {
                         self.run = Run::new(at, self.run.number, self.believed());
                     }
                     let turned = wrap(at.heading_rad - self.run.start.heading_rad);
                     let travelled = if self.run.looks == 0 { 0.0 } else { self.travelled() };
                     let how = Look { number: self.run.number, travelled_m: travelled, turned_rad: turned };
+                    self.run.asked = Some(how);
                     look = Some(request(&self.g, self.window_px, how, Header::new(self.seq + 1, now)));
                     self.phase = Phase::Looking { until_ns: now + (g.look_timeout_s * 1e9) as u64 };
                 }

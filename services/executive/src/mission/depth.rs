@@ -102,8 +102,13 @@ pub(crate) fn check_depth(d: &DepthGoal) -> Result<(), &'static str> {
     if r <= l || b <= t {
         return Err("window_px must run left to right and top to bottom");
     }
-    if d.step_m <= 0.0 || d.speed_mps <= 0.0 || d.sphere_m <= 0.0 || d.goal_tolerance_m <= 0.0 {
-        return Err("step_m, speed_mps, sphere_m and goal_tolerance_m must be above zero");
+    if d.step_m <= 0.0
+        || d.speed_mps <= 0.0
+        || d.sphere_m <= 0.0
+        || d.goal_tolerance_m <= 0.0
+        || d.look_timeout_s <= 0.0
+    {
+        return Err("step_m, speed_mps, sphere_m, goal_tolerance_m and look_timeout_s must be above zero");
     }
     if d.frames < 2 || d.min_frames < 2 {
         return Err("frames and min_frames must be at least 2: depth needs two looks");
