@@ -9,7 +9,6 @@
 mod common;
 
 use std::collections::BTreeMap;
-use std::path::Path;
 
 use harvey_msgs::{Pose2, TruePose, VisionAlgorithm, VisionResult, VisionStatus};
 use harvey_world::Mover;
@@ -152,25 +151,14 @@ fn table(samples: &Samples) -> String {
 /// Sweeps the mission over `seeds` under `conditions`: each run's figures and whether the
 /// executive reached the goal.
 fn sweep(seeds: &str, conditions: &[&str]) -> Vec<(String, u64, bool, Figures)> {
-    let (prefix, out) = (common::unique_prefix("depthob"), common::scratch("depthob"));
-    let joined = conditions.join(",");
-    let args =
-        ["sweep", "missions/depth-obstacles.toml", "--seeds", seeds, "--conditions", &joined, "--in-process"];
-    let run = common::harvey(&args)
-        .args(["--jobs", "2", "--keep", "--out", out.to_str().expect("utf8"), "--prefix", &prefix])
-        .output()
-        .expect("runs");
-    assert!(out.join("sweep.csv").exists(), "{}", String::from_utf8_lossy(&run.stderr));
-    let (lo, hi) = seeds.split_once("..").expect("a range");
-    let (lo, hi): (u64, u64) = (lo.parse().expect("seed"), hi.parse().expect("seed"));
     let movers = movers();
-    let mut rows = Vec::new();
-    for c in conditions {
-        for seed in lo..=hi {
-            let dir = out.join("runs").join(format!("{c}-s{seed}"));
-            let log = std::fs::read_to_string(dir.join("harvey-run.log")).unwrap_or_default();
-            let f = figures(&std::fs::read(Path::new(&dir).join("run.mcap")).expect("recording"), &movers);
-            let reached = log.contains("goal reached");
+    common::sweeps::sweep(
+        "missions/depth-obstacles.toml",
+        "depthob",
+        seeds,
+        conditions,
+        |c, seed, reached, dir| {
+            let f = figures(&std::fs::read(dir.join("run.mcap")).expect("recording"), &movers);
             let clearance: Vec<String> = f.clearance_m.iter().map(|(n, c)| format!("{n} {c:.2} m")).collect();
             println!(
                 "{c} s{seed}: {} {:.2} m from the goal; clearance {}; found by depth from motion: {:?}",
@@ -179,10 +167,9 @@ fn sweep(seeds: &str, conditions: &[&str]) -> Vec<(String, u64, bool, Figures)> 
                 clearance.join(", "),
                 f.found
             );
-            rows.push((c.to_string(), seed, reached, f));
-        }
-    }
-    rows
+            (c.to_string(), seed, reached, f)
+        },
+    )
 }
 
 // Over seeds 1..4 of each camera (nominal, dim, harsh) every run reached the goal by its own

@@ -9,8 +9,6 @@
 
 mod common;
 
-use std::path::Path;
-
 use harvey_geometry::distance_to_segment;
 use harvey_msgs::{TruePose, UncertaintyMap};
 
@@ -78,38 +76,21 @@ fn figures(mcap: &[u8]) -> Figures {
 /// Sweeps `mission` over `seeds` under `conditions`: each run's figures (the log says whether
 /// the goal was reached).
 fn sweep(mission: &str, tag: &str, seeds: &str, conditions: &[&str]) -> Vec<(String, u64, bool, Figures)> {
-    let (prefix, out) = (common::unique_prefix(tag), common::scratch(tag));
-    let joined = conditions.join(",");
-    let args = ["sweep", mission, "--seeds", seeds, "--conditions", &joined, "--in-process"];
-    let run = common::harvey(&args)
-        .args(["--jobs", "2", "--keep", "--out", out.to_str().expect("utf8"), "--prefix", &prefix])
-        .output()
-        .expect("runs");
-    assert!(out.join("sweep.csv").exists(), "{}", String::from_utf8_lossy(&run.stderr));
-    let (lo, hi) = seeds.split_once("..").expect("a range");
-    let (lo, hi): (u64, u64) = (lo.parse().expect("seed"), hi.parse().expect("seed"));
-    let mut rows = Vec::new();
-    for c in conditions {
-        for seed in lo..=hi {
-            let dir = out.join("runs").join(format!("{c}-s{seed}"));
-            let log = std::fs::read_to_string(dir.join("harvey-run.log")).unwrap_or_default();
-            let f = figures(&std::fs::read(Path::new(&dir).join("run.mcap")).expect("recording"));
-            let reached = log.contains("goal reached");
-            println!(
-                "{mission} {c} s{seed}: {} off the centreline median {:.3} worst {:.3} m, {:.2} m from the end, \
-                 map {:.3} m² (median), {:.3} m² (first 26 m), {:.3} m² (end)",
-                if reached { "reached," } else { "FAILED," },
-                f.median_m,
-                f.worst_m,
-                f.end_m,
-                f.area_median_m2,
-                f.area_first_m2,
-                f.area_end_m2
-            );
-            rows.push((c.to_string(), seed, reached, f));
-        }
-    }
-    rows
+    common::sweeps::sweep(mission, tag, seeds, conditions, |c, seed, reached, dir| {
+        let f = figures(&std::fs::read(dir.join("run.mcap")).expect("recording"));
+        println!(
+            "{mission} {c} s{seed}: {} off the centreline median {:.3} worst {:.3} m, {:.2} m from the end, \
+             map {:.3} m² (median), {:.3} m² (first 26 m), {:.3} m² (end)",
+            if reached { "reached," } else { "FAILED," },
+            f.median_m,
+            f.worst_m,
+            f.end_m,
+            f.area_median_m2,
+            f.area_first_m2,
+            f.area_end_m2
+        );
+        (c.to_string(), seed, reached, f)
+    })
 }
 
 // Over seeds 1..3 of each camera the robot kept within 0.004-0.015 m of the centreline (median),

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod docked;
+pub mod sweeps;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
