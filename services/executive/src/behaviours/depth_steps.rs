@@ -85,7 +85,7 @@ impl DepthObstacles {
                     (0.0, 0.0)
                 } else {
                     self.phase = Phase::Moving { to, deadline_ns };
-                    // Hold the run's heading: steer for the run's line, not only the step's end.
+                    // Steer for the step's end, which lies on the run's line (its heading held).
                     let e = wrap(dy.atan2(dx) - at.heading_rad);
                     (g.speed_mps.min(ARRIVE_GAIN * ahead), (g.turn_gain * e).clamp(-max_turn, max_turn))
                 }
