@@ -41,6 +41,10 @@ pub struct SweepArgs {
     /// Keep the recordings of successful runs too (failed runs always keep theirs).
     #[arg(long)]
     pub keep: bool,
+    /// Also draw each run's Rerun file (`run.rrd`, as large as its recording; without it,
+    /// `harvey export RUN/run.mcap -o RUN/run.rrd` draws a kept run afterwards).
+    #[arg(long)]
+    pub rrd: bool,
     /// Bus prefix the runs' prefixes start with (default: sweep<pid>_).
     #[arg(long)]
     pub prefix: Option<String>,
@@ -106,7 +110,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<i32> {
             harvey_bus::validate_prefix(&prefix)?;
             let launch = plan::launch_copy_path(&args.mission, &tag);
             temps.0.push(launch.clone());
-            let launch_text = plan::launch_copy(&launch_text, seed, &worlds[ci])?;
+            let launch_text = plan::launch_copy(&launch_text, seed, &worlds[ci], args.rrd)?;
             jobs.push(runner::Job {
                 condition: ci,
                 seed,

@@ -3,9 +3,10 @@
 
 use std::path::Path;
 
-/// Sweeps `mission` over `seeds` (`A..B`) under `conditions`, two runs at a time, and calls
-/// `read` with each run's condition, seed, whether the mission logged its goal reached, and its
-/// folder (`run.mcap`, `harvey-run.log`).
+/// Sweeps `mission` over `seeds` (`A..B`) under `conditions` and calls `read` with each run's
+/// condition, seed, whether the mission logged its goal reached, and its folder (`run.mcap`,
+/// `harvey-run.log`). One seed at a time, its conditions side by side (two at once), and each
+/// seed's recordings removed once read: a run keeps hundreds of MB, and CI's disk is finite.
 pub fn sweep<T>(
     mission: &str,
     tag: &str,
@@ -13,20 +14,27 @@ pub fn sweep<T>(
     conditions: &[&str],
     mut read: impl FnMut(&str, u64, bool, &Path) -> T,
 ) -> Vec<T> {
-    let (prefix, out) = (super::unique_prefix(tag), super::scratch(tag));
-    let joined = conditions.join(",");
-    let args = ["sweep", mission, "--seeds", seeds, "--conditions", &joined, "--in-process"];
-    let run = super::harvey(&args)
-        .args(["--jobs", "2", "--keep", "--out", out.to_str().expect("utf8"), "--prefix", &prefix])
-        .output()
-        .expect("runs");
-    assert!(out.join("sweep.csv").exists(), "{}", String::from_utf8_lossy(&run.stderr));
     let (lo, hi) = seeds.split_once("..").expect("a range");
     let (lo, hi): (u64, u64) = (lo.parse().expect("seed"), hi.parse().expect("seed"));
+    let joined = conditions.join(",");
     let mut rows = Vec::new();
-    for c in conditions {
-        for seed in lo..=hi {
+    for seed in lo..=hi {
+        let (prefix, out) = (super::unique_prefix(tag), super::scratch(tag));
+        let one = seed.to_string();
+        let args = ["sweep", mission, "--seeds", &one, "--conditions", &joined, "--in-process"];
+        let run = super::harvey(&args)
+            .args(["--jobs", "2", "--keep", "--out", out.to_str().expect("utf8"), "--prefix", &prefix])
+            .output()
+            .expect("runs");
+        let said =
+            || format!("{}{}", String::from_utf8_lossy(&run.stdout), String::from_utf8_lossy(&run.stderr));
+        for c in conditions {
             let dir = out.join("runs").join(format!("{c}-s{seed}"));
+            assert!(
+                dir.join("run.mcap").is_file(),
+                "{c} s{seed} left no recording; the sweep said:\n{}",
+                said()
+            );
             let log = std::fs::read_to_string(dir.join("harvey-run.log")).unwrap_or_default();
             rows.push(read(c, seed, log.contains("goal reached"), &dir));
         }

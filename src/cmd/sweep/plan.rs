@@ -53,9 +53,19 @@ pub fn world_copy_path(mission: &Path, condition: &str) -> PathBuf {
 }
 
 /// The launch file `text` with `[launch] seed = seed` and `world = world` (a path relative to
-/// the launch file's folder, or absolute).
-pub fn launch_copy(text: &str, seed: u64, world: &Path) -> Result<String, anyhow::Error> {
+/// the launch file's folder, or absolute); without `rrd`, no service draws a Rerun file (its
+/// `--rrd PATH` dropped: a sweep is for figures, and each run's drawing is as large as its
+/// recording; `harvey export` draws a kept recording afterwards).
+pub fn launch_copy(text: &str, seed: u64, world: &Path, rrd: bool) -> Result<String, anyhow::Error> {
     let mut launch: toml::Table = toml::from_str(text)?;
+    if !rrd {
+        let services = launch.get_mut("service").and_then(toml::Value::as_array_mut);
+        for args in services.into_iter().flatten().filter_map(|s| s.get_mut("args")?.as_array_mut()) {
+            if let Some(at) = args.iter().position(|a| a.as_str() == Some("--rrd")) {
+                args.drain(at..(at + 2).min(args.len()));
+            }
+        }
+    }
     let settings = launch
         .get_mut("launch")
         .and_then(toml::Value::as_table_mut)
@@ -104,7 +114,7 @@ mod tests {
     fn the_copy_sets_seed_and_world_and_keeps_the_rest() {
         let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/missions/docking.toml"))
             .expect("mission");
-        let copy = launch_copy(&text, 8, Path::new("/tmp/w.toml")).expect("copy");
+        let copy = launch_copy(&text, 8, Path::new("/tmp/w.toml"), true).expect("copy");
         let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/missions/.x.toml"));
         let lf = harvey_supervisor::LaunchFile::parse(&copy, path).expect("still a launch file");
         let orig = harvey_supervisor::LaunchFile::parse(&text, path).expect("launch file");
@@ -113,5 +123,23 @@ mod tests {
         assert_eq!(lf.services.len(), orig.services.len());
         let [a, b]: [toml::Table; 2] = [&copy, &text].map(|t| toml::from_str(t).expect("toml"));
         assert_eq!(a.get("mission"), b.get("mission"));
+        assert_eq!(a.get("service"), b.get("service"), "with `rrd`, the services as they were");
+    }
+
+    #[test]
+    fn without_rrd_the_recorder_draws_no_rerun_file_and_keeps_its_other_arguments() {
+        let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/missions/docking.toml"))
+            .expect("mission");
+        let recorder = |t: &str| {
+            let lf = harvey_supervisor::LaunchFile::parse(t, Path::new("/m/x.toml")).expect("launch file");
+            lf.services.into_iter().find(|s| s.name.get_ref() == "recorder").expect("a recorder").args
+        };
+        let before = recorder(&text);
+        let at = before.iter().position(|a| a == "--rrd").expect("the mission draws a Rerun file");
+        let after = recorder(&launch_copy(&text, 1, Path::new("w.toml"), false).expect("copy"));
+        let mut expected = before.clone();
+        expected.drain(at..at + 2);
+        assert_eq!(after, expected);
+        assert!(after.iter().any(|a| a == "--output"), "{after:?}");
     }
 }
