@@ -2,7 +2,7 @@
 //! hall while the executive believes it 3 or 6 inches to one side; the vision workers correlate
 //! the mission's landmark vertices in the rendered frames, and each fix puts the belief back
 //! near the simulator's truth: within the nominal sensors' budget (seeds 1..10 of the sweep gave
-//! at most 2.5 in; the paper's 1.5 in holds in the ideal world, `tests/pose_refine.rs`).
+//! at most 2.65 in; the paper's 1.5 in holds in the ideal world, `tests/pose_refine.rs`).
 
 use harvey_executive::Output;
 use harvey_geometry::INCH;

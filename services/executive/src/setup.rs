@@ -203,6 +203,7 @@ impl Site<'_> {
             max_sd_m: r.max_sd_m.unwrap_or(f64::INFINITY),
             growth: Growth::of(w),
             world: Some(w.clone()),
+            choose: r.choose,
         }))
     }
 

@@ -55,6 +55,11 @@ pub struct Refine {
     /// reflectance differs from its wall's by at least this much (those in view of each pose
     /// are asked for).
     pub select_contrast: Option<f64>,
+    /// With more vertices in view than a fix can ask for (16), which: `nearest` or
+    /// `most-telling`, those that most shrink the fix's expected position spread (000 §5.1:
+    /// landmarks chosen for the information they offer).
+    #[serde(default)]
+    pub choose: crate::servo::vertices::Choose,
     pub template_px: u32,
     pub min_score: f64,
     /// How well the expected pose is known: x, y (m) and heading (degrees).

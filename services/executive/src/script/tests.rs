@@ -10,7 +10,7 @@ use super::leg::Tracking;
 use super::{Script, WAIT_NS};
 use crate::mission::{Servo, Step};
 use crate::servo::pose::{PinholeCamera, RefineParams};
-use crate::servo::vertices::{Growth, RefineSetup};
+use crate::servo::vertices::{Choose, Growth, RefineSetup};
 use crate::{Executive, Mode, Output};
 
 fn two_steps() -> Vec<Step> {
@@ -247,6 +247,7 @@ fn refining() -> RefineSetup {
         max_sd_m: f64::INFINITY,
         growth: Growth::default(),
         world: None,
+        choose: Choose::Nearest,
     }
 }
 

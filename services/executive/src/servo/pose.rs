@@ -103,7 +103,7 @@ impl Refined {
 
 /// The smallest prior standard deviation used, so that a pitch held level keeps the normal
 /// equations well scaled.
-const HELD_SD: f64 = 1e-6;
+pub const HELD_SD: f64 = 1e-6;
 
 /// Gauss-Newton on `(x, y, heading, pitch)`; `None` with fewer than two matches left.
 pub fn refine(
@@ -153,9 +153,6 @@ fn solve(
     kept: &[usize],
     p: &RefineParams,
 ) -> Option<(Pose2, f64, Normal)> {
-    let project = |v: [f64; N], w: [f64; 3]| {
-        cam.project_tilted(Pose2 { x_m: v[0], y_m: v[1], heading_rad: v[2] }, v[3], w)
-    };
     let prior = [expected.x_m, expected.y_m, expected.heading_rad, 0.0];
     let prior_sd = [p.prior_sd[0], p.prior_sd[1], p.prior_sd[2], p.pitch_sd_rad].map(|sd| sd.max(HELD_SD));
     let mut v = prior;
@@ -177,18 +174,9 @@ fn solve(
         };
         let image_var = p.image_sd_px * p.image_sd_px;
         for &i in kept {
-            let at = project(v, m[i].world_m)?;
-            let (dx, dy) = (m[i].world_m[0] - v[0], m[i].world_m[1] - v[1]);
-            let depth = (dx * v[2].cos() + dy * v[2].sin()).max(0.05);
-            let var = image_var + (cam.focal_px * p.map_sd_m / depth).powi(2);
-            for (axis, &now) in at.iter().enumerate() {
-                let mut j = [0.0; N];
-                for (k, jk) in j.iter_mut().enumerate() {
-                    let mut h = v;
-                    h[k] += 1e-6;
-                    *jk = (project(h, m[i].world_m)?[axis] - now) / 1e-6;
-                }
-                add(j, m[i].image_px[axis] - now, 1.0 / image_var, var);
+            let (at, jacobian, var) = image_rows(cam, v, m[i].world_m, p)?;
+            for axis in 0..2 {
+                add(jacobian[axis], m[i].image_px[axis] - at[axis], 1.0 / image_var, var);
             }
         }
         for k in 0..N {
@@ -207,6 +195,32 @@ fn solve(
         }
     }
     Some((Pose2 { x_m: v[0], y_m: v[1], heading_rad: v[2] }, v[3], normal))
+}
+
+/// Where world point `w` appears from `(x, y, heading, pitch)` = `v`, the image column's and
+/// row's derivatives by each of them (forward differences), and either's variance: the image
+/// noise and the map error at the point's depth.
+pub fn image_rows(
+    cam: &PinholeCamera,
+    v: [f64; N],
+    w: [f64; 3],
+    p: &RefineParams,
+) -> Option<([f64; 2], [[f64; N]; 2], f64)> {
+    let project =
+        |v: [f64; N]| cam.project_tilted(Pose2 { x_m: v[0], y_m: v[1], heading_rad: v[2] }, v[3], w);
+    let at = project(v)?;
+    let (dx, dy) = (w[0] - v[0], w[1] - v[1]);
+    let depth = (dx * v[2].cos() + dy * v[2].sin()).max(0.05);
+    let var = p.image_sd_px * p.image_sd_px + (cam.focal_px * p.map_sd_m / depth).powi(2);
+    let mut jacobian = [[0.0; N]; 2];
+    for (axis, row) in jacobian.iter_mut().enumerate() {
+        for (k, jk) in row.iter_mut().enumerate() {
+            let mut h = v;
+            h[k] += 1e-6;
+            *jk = (project(h)?[axis] - at[axis]) / 1e-6;
+        }
+    }
+    Some((at, jacobian, var))
 }
 
 #[cfg(test)]

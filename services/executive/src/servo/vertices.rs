@@ -3,6 +3,7 @@
 
 use harvey_msgs::Pose2;
 
+use crate::servo::choose::most_telling;
 use crate::servo::pose::{PinholeCamera, RefineParams};
 
 /// What refining needs from the world: each vertex with the landmark its request is anchored
@@ -22,6 +23,19 @@ pub struct RefineSetup {
     /// The world, to ask only for vertices in view and not hidden behind a wall; without it,
     /// every vertex is asked for.
     pub world: Option<harvey_world::World>,
+    /// Which `MAX_ASKED` to ask for when more are in view.
+    pub choose: Choose,
+}
+
+/// How a fix chooses among more vertices in view than it can ask for.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Choose {
+    /// The nearest.
+    #[default]
+    Nearest,
+    /// Those that most shrink the fix's expected position spread (`choose.rs`).
+    MostTelling,
 }
 
 /// How much less the believed pose is worth per metre travelled since the last fix, from the
@@ -63,7 +77,8 @@ pub const MIN_ASKED: usize = 3;
 
 impl RefineSetup {
     /// The vertices (indices) worth asking for from `pose`: in the image clear of its edges by a
-    /// template, 0.5 to 20 m ahead, with no wall between; the nearest `MAX_ASKED`, in list order.
+    /// template, 0.5 to 20 m ahead, with no wall between; of those, `MAX_ASKED` by `choose`, in
+    /// list order.
     pub fn in_view(&self, pose: Pose2, image_px: [f64; 2]) -> Vec<usize> {
         let margin = f64::from(self.template_px);
         let mut seen: Vec<(usize, f64)> = self
@@ -84,9 +99,17 @@ impl RefineSetup {
                 (inside && clear && (0.5..20.0).contains(&d)).then_some((i, d))
             })
             .collect();
-        seen.sort_by(|a, b| a.1.total_cmp(&b.1));
-        seen.truncate(MAX_ASKED);
-        let mut ids: Vec<usize> = seen.into_iter().map(|(i, _)| i).collect();
+        let mut ids: Vec<usize> = match self.choose {
+            Choose::Nearest => {
+                seen.sort_by(|a, b| a.1.total_cmp(&b.1));
+                seen.into_iter().take(MAX_ASKED).map(|(i, _)| i).collect()
+            }
+            Choose::MostTelling => {
+                let candidates: Vec<(usize, [f64; 3])> =
+                    seen.iter().map(|&(i, _)| (i, self.vertices[i].2)).collect();
+                most_telling(&self.camera, pose, &self.params, &candidates, MAX_ASKED)
+            }
+        };
         ids.sort_unstable();
         ids
     }
