@@ -103,6 +103,8 @@ pub struct Pace {
     /// Deterministic mode: the supervisor's requests to re-offer to a restarted party.
     reoffers: Option<std::rc::Rc<crate::Reoffers>>,
     pending: RefCell<VecDeque<u64>>,
+    /// The latest tick taken into `pending`: a report of it or an earlier one again is dropped.
+    latest: Cell<Option<u64>>,
     current: Cell<Option<u64>>,
     stopping: Cell<bool>,
 }
@@ -122,6 +124,7 @@ impl Pace {
             lockstep,
             reoffers: None,
             pending: RefCell::new(VecDeque::new()),
+            latest: Cell::new(None),
             current: Cell::new(None),
             stopping: Cell::new(false),
         }
@@ -172,7 +175,17 @@ impl Pace {
             if let Some(r) = &self.reoffers {
                 r.serve()?;
             }
-            l.finished(|t| self.pending.borrow_mut().push_back(t))?;
+            // A tick is run once, however often it is reported: a restarted predecessor may
+            // report again a tick it had reported before it died (its checkpoint a tick behind),
+            // and a second turn for it would drain the next tick's inputs early.
+            l.finished(|t| {
+                if self.latest.get().is_some_and(|latest| t <= latest) {
+                    tracing::info!(party = l.party(), tick_ns = t, "a tick reported again: run once");
+                } else {
+                    self.latest.set(Some(t));
+                    self.pending.borrow_mut().push_back(t);
+                }
+            })?;
             match wake {
                 Wake::Shutdown => self.stopping.set(true),
                 Wake::Timeout if self.pending.borrow().is_empty() => return Ok(Step::Idle),

@@ -1,10 +1,11 @@
-//! The bus within one process (two nodes): typed delivery with wake-ups, frames in place, and
-//! clear errors for a topic opened with the wrong type and for bad prefixes.
+//! The bus within one process (two nodes): typed delivery with wake-ups, frames in place, a
+//! clock party that runs a tick once however often it is reported, and clear errors for a topic
+//! opened with the wrong type and for bad prefixes.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 use std::time::Duration;
 
-use harvey_bus::{Bus, BusError, Waiter, Wake};
+use harvey_bus::{Bus, BusError, Lockstep, Pace, Step, Waiter, Wake};
 use harvey_msgs::{Encoding, FrameHeader, Header, Pose2, Qos, Topic, TruePose, UncertaintyMap, topics};
 
 fn prefix(tag: &str) -> String {
@@ -35,6 +36,30 @@ fn messages_arrive_in_order_and_wake_the_waiter() {
         assert_eq!(got.iter().map(|m| m.header.seq).collect::<Vec<_>>(), [1, 2, 3]);
         // Drained and its wake-ups consumed: the waiter sleeps again.
         assert_eq!(waiter.wait(Some(Duration::from_millis(50))).expect("wait"), Wake::Timeout);
+    }
+    harvey_bus::retire_domain(&p).expect("retire");
+}
+
+#[test]
+fn a_tick_reported_again_by_a_restarted_predecessor_is_run_once() {
+    let p = prefix("r");
+    {
+        let bus = Bus::join_with_prefix("r", &p).expect("join");
+        let me = Pace::with(Some(Lockstep::new(&bus, "me", "pred").expect("party")));
+        let waiter = Waiter::new().expect("waiter");
+        let _a = me.attach(&waiter, &[]).expect("attach");
+        let pred = Lockstep::new(&bus, "pred", "tail").expect("predecessor");
+        pred.finish(50).expect("report");
+        // The predecessor restarted from a checkpoint a tick behind: it reports 50 again.
+        let restarted = Lockstep::new(&bus, "pred", "tail").expect("restarted");
+        restarted.finish(50).expect("report");
+        restarted.finish(100).expect("report");
+        let mut turns = Vec::new();
+        while let Step::Go(t) = me.next(&waiter, Some(Duration::from_millis(300))).expect("next") {
+            turns.push(t);
+            me.done().expect("done");
+        }
+        assert_eq!(turns, [Some(50), Some(100)]);
     }
     harvey_bus::retire_domain(&p).expect("retire");
 }
