@@ -57,7 +57,7 @@ pub(super) fn place(
     let [u, _, z, sd, frames, class] = v;
     let good = class > 0.5
         && frames >= f64::from(g.min_frames)
-        && z > 0.0
+        && z >= g.min_range_m
         && sd <= g.max_rel_sd * z
         && z <= g.max_range_m;
     if !good {
@@ -161,12 +161,14 @@ mod tests {
         let q = place(&g, [375.4 + shift, 300.0, 4.0, 0.1, 5.0, 1.0], shift, turned, (554.0, 320.0))
             .expect("placed");
         assert!((q[0] - p[0]).abs() < 1e-9 && (q[1] - p[1]).abs() < 1e-9, "{q:?} vs {p:?}");
-        // On the floor, unsure, too few looks or beyond range: not an obstacle.
+        // On the floor, unsure, too few looks, beyond range or nearer than the camera's points
+        // are trusted: not an obstacle.
         for v in [
             [320.0, 300.0, 4.0, 0.1, 5.0, 0.0],
             [320.0, 300.0, 4.0, 0.9, 5.0, 1.0],
             [320.0, 300.0, 4.0, 0.1, 2.0, 1.0],
             [320.0, 300.0, 9.0, 0.1, 5.0, 1.0],
+            [391.0, 395.0, 0.82, 0.01, 3.0, 1.0],
         ] {
             assert_eq!(place(&g, v, 0.0, here, (554.0, 320.0)), None, "{v:?}");
         }

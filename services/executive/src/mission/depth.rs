@@ -33,10 +33,11 @@ pub struct DepthGoal {
     pub max_points: u32,
     pub noise_px: f64,
     /// A point is an obstacle once it stands off the floor, has been matched in `min_frames`
-    /// frames, its depth's spread is at most `max_rel_sd` of it and it is nearer than
-    /// `max_range_m`.
+    /// frames, its depth's spread is at most `max_rel_sd` of it and it is between `min_range_m`
+    /// and `max_range_m` away (nearer, what the camera's points say is the sonar's to judge).
     pub min_frames: u32,
     pub max_rel_sd: f64,
+    pub min_range_m: f64,
     pub max_range_m: f64,
     /// The motor schemas (001 §3.1): move-to-goal's gain (m/s); avoid-static-obstacle round each
     /// obstacle (its points linked within `link_m`) from its nearest point, of radius
@@ -82,6 +83,7 @@ pub(crate) fn check_bounds(k: &KeyPath, d: &DepthGoal) -> Result<(), OutOfRange>
     check(&k.key("noise_px"), d.noise_px, &Range::above(0.0, 100.0, "px"))?;
     check(&k.key("min_frames"), f64::from(d.min_frames), &COUNT)?;
     check(&k.key("max_rel_sd"), d.max_rel_sd, &FRACTION)?;
+    check(&k.key("min_range_m"), d.min_range_m, &LENGTH)?;
     check(&k.key("max_range_m"), d.max_range_m, &LENGTH)?;
     check(&k.key("goal_gain"), d.goal_gain, &GAIN)?;
     check(&k.key("link_m"), d.link_m, &LENGTH)?;
@@ -109,6 +111,9 @@ pub(crate) fn check_depth(d: &DepthGoal) -> Result<(), &'static str> {
         || d.look_timeout_s <= 0.0
     {
         return Err("step_m, speed_mps, sphere_m, goal_tolerance_m and look_timeout_s must be above zero");
+    }
+    if d.min_range_m >= d.max_range_m {
+        return Err("min_range_m must be below max_range_m");
     }
     if d.frames < 2 || d.min_frames < 2 {
         return Err("frames and min_frames must be at least 2: depth needs two looks");
