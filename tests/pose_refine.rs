@@ -3,9 +3,9 @@
 //! belief it finds the mission's landmark vertices by correlation and refines its pose. In the
 //! ideal world every fix is within the paper's 1.5 in of the truth; over seeds 1..3 under the
 //! shipped sensors (`nominal`) and the `dim` condition, within the budget `docs/evaluation.md`
-//! reports (the map's 1 cm errors alone leave 1.8 in median there). The vertices are chosen by
-//! the world model's landmark selection (000 §5.2); in the ideal world the hand-listed ones
-//! (`missions/pose-refine-listed.toml`) are held to the same 1.5 in.
+//! reports (the map's 1 cm errors alone left 1.8 in median with the listed vertices). The
+//! vertices are chosen by the world model's landmark selection (000 §5.2); in the ideal world
+//! the hand-listed ones (`missions/pose-refine-listed.toml`) are held to the same 1.5 in.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;

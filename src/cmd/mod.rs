@@ -12,6 +12,7 @@ mod live;
 pub mod recover;
 pub mod replay;
 mod replay_launch;
+mod rrd_arg;
 pub mod run;
 pub mod sweep;
 pub mod topic;

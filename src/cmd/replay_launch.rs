@@ -69,8 +69,9 @@ pub fn foreign_binaries(text: &str) -> anyhow::Result<Vec<String>> {
 }
 
 /// The launch file of a replay of `recording`, from the launch file that recorded it. Without
-/// `rrd`, services lose their `--rrd FILE` arguments: a replay checks and records the MCAP, and
-/// `harvey export` draws it when wanted.
+/// `rrd`, the recorder loses its `--rrd FILE`: a replay checks and records the MCAP, and
+/// `harvey export` draws it when wanted; with it, the recorder draws `run.rrd` in the run folder
+/// whether or not the recording's did.
 pub fn replay_launch(text: &str, recording: &Path, rrd: bool) -> anyhow::Result<String> {
     let mut doc: toml::Table = text.parse()?;
     let launch = doc.get_mut("launch").and_then(|l| l.as_table_mut()).context("no [launch] table")?;
@@ -89,15 +90,10 @@ pub fn replay_launch(text: &str, recording: &Path, rrd: bool) -> anyhow::Result<
     let at =
         services.iter().position(is_input).context("no input service (simulated DRV, bridge, camera)")?;
     services.retain(|s| !is_input(s));
-    if !rrd {
-        for s in services.iter_mut() {
-            if let Some(args) = s.get_mut("args").and_then(|a| a.as_array_mut())
-                && let Some(i) = args.iter().position(|a| a.as_str() == Some("--rrd"))
-                && i + 1 < args.len()
-            {
-                args.drain(i..i + 2);
-            }
-        }
+    // A sweep's runs were recorded without a Rerun file: asked for, the replay draws one.
+    match rrd {
+        true => super::rrd_arg::ensure_rrd(services, "${run_dir}/run.rrd"),
+        false => super::rrd_arg::drop_rrd(services),
     }
     let mut replayer = toml::Table::new();
     replayer.insert("name".into(), "replayer".into());

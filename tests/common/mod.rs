@@ -35,6 +35,8 @@ pub fn unique_prefix(tag: &str) -> String {
 
 /// A fresh scratch folder under the target directory, removed when the test passes and kept
 /// (and named) when it fails: the runs' recordings are hundreds of MB, and CI's disk is finite.
+/// (A sweep one seed at a time, `sweeps::sweep`, removes each seed's once read: a check made
+/// over all the runs afterwards keeps none; sweep the failing seed again to look at it.)
 pub fn scratch(tag: &str) -> Scratch {
     let d = bin_dir().join("test-scratch").join(format!("{tag}-{}", unique_prefix("")));
     let _ = std::fs::remove_dir_all(&d);

@@ -53,18 +53,13 @@ pub fn world_copy_path(mission: &Path, condition: &str) -> PathBuf {
 }
 
 /// The launch file `text` with `[launch] seed = seed` and `world = world` (a path relative to
-/// the launch file's folder, or absolute); without `rrd`, no service draws a Rerun file (its
+/// the launch file's folder, or absolute); without `rrd`, the recorder draws no Rerun file (its
 /// `--rrd PATH` dropped: a sweep is for figures, and each run's drawing is as large as its
 /// recording; `harvey export` draws a kept recording afterwards).
 pub fn launch_copy(text: &str, seed: u64, world: &Path, rrd: bool) -> Result<String, anyhow::Error> {
     let mut launch: toml::Table = toml::from_str(text)?;
-    if !rrd {
-        let services = launch.get_mut("service").and_then(toml::Value::as_array_mut);
-        for args in services.into_iter().flatten().filter_map(|s| s.get_mut("args")?.as_array_mut()) {
-            if let Some(at) = args.iter().position(|a| a.as_str() == Some("--rrd")) {
-                args.drain(at..(at + 2).min(args.len()));
-            }
-        }
+    if !rrd && let Some(services) = launch.get_mut("service").and_then(toml::Value::as_array_mut) {
+        crate::cmd::rrd_arg::drop_rrd(services);
     }
     let settings = launch
         .get_mut("launch")

@@ -57,6 +57,7 @@ pub(super) fn place(
     let [u, _, z, sd, frames, class] = v;
     let good = class > 0.5
         && frames >= f64::from(g.min_frames)
+        && z > 0.0
         && z >= g.min_range_m
         && sd <= g.max_rel_sd * z
         && z <= g.max_range_m;

@@ -6,7 +6,7 @@ use harvey_config::range::{OutOfRange, Range, check, check_all};
 use harvey_config::spans::KeyPath;
 use serde::Deserialize;
 
-use super::bounds::{LENGTH, POSITION};
+use super::bounds::{LENGTH, LENGTH_OR_ZERO, POSITION};
 use super::bounds_goals::{GAIN, SPEED, TURN_GAIN, TURN_RATE, WAIT};
 
 /// `[mission.depth]`.
@@ -37,6 +37,8 @@ pub struct DepthGoal {
     /// and `max_range_m` away (nearer, what the camera's points say is the sonar's to judge).
     pub min_frames: u32,
     pub max_rel_sd: f64,
+    /// (Absent in launch files recorded before it: 0, any depth, as they ran.)
+    #[serde(default)]
     pub min_range_m: f64,
     pub max_range_m: f64,
     /// The motor schemas (001 §3.1): move-to-goal's gain (m/s); avoid-static-obstacle round each
@@ -83,7 +85,7 @@ pub(crate) fn check_bounds(k: &KeyPath, d: &DepthGoal) -> Result<(), OutOfRange>
     check(&k.key("noise_px"), d.noise_px, &Range::above(0.0, 100.0, "px"))?;
     check(&k.key("min_frames"), f64::from(d.min_frames), &COUNT)?;
     check(&k.key("max_rel_sd"), d.max_rel_sd, &FRACTION)?;
-    check(&k.key("min_range_m"), d.min_range_m, &LENGTH)?;
+    check(&k.key("min_range_m"), d.min_range_m, &LENGTH_OR_ZERO)?;
     check(&k.key("max_range_m"), d.max_range_m, &LENGTH)?;
     check(&k.key("goal_gain"), d.goal_gain, &GAIN)?;
     check(&k.key("link_m"), d.link_m, &LENGTH)?;

@@ -29,7 +29,9 @@ impl Script {
         }
         let expected = self.estimated;
         let c = setup.camera.centre_px;
-        self.asked = setup.in_view(expected, [2.0 * c[0], 2.0 * c[1]]);
+        // Chosen for the prior the fix will have: what dead reckoning since the last fix leaves.
+        let params = setup.growth.widen(&setup.params, self.belief.travelled_m());
+        self.asked = setup.in_view(expected, [2.0 * c[0], 2.0 * c[1]], &params);
         if self.asked.len() < MIN_ASKED {
             tracing::info!(in_view = self.asked.len(), "too few landmark vertices in view for a pose fix");
             return self.step_done(step, expected, now, sequel);

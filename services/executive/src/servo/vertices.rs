@@ -77,9 +77,9 @@ pub const MIN_ASKED: usize = 3;
 
 impl RefineSetup {
     /// The vertices (indices) worth asking for from `pose`: in the image clear of its edges by a
-    /// template, 0.5 to 20 m ahead, with no wall between; of those, `MAX_ASKED` by `choose`, in
-    /// list order.
-    pub fn in_view(&self, pose: Pose2, image_px: [f64; 2]) -> Vec<usize> {
+    /// template, 0.5 to 20 m ahead, with no wall between; of those, `MAX_ASKED` by `choose`
+    /// (the most telling for a fix with `params`' priors), in list order.
+    pub fn in_view(&self, pose: Pose2, image_px: [f64; 2], params: &RefineParams) -> Vec<usize> {
         let margin = f64::from(self.template_px);
         let mut seen: Vec<(usize, f64)> = self
             .vertices
@@ -107,7 +107,7 @@ impl RefineSetup {
             Choose::MostTelling => {
                 let candidates: Vec<(usize, [f64; 3])> =
                     seen.iter().map(|&(i, _)| (i, self.vertices[i].2)).collect();
-                most_telling(&self.camera, pose, &self.params, &candidates, MAX_ASKED)
+                most_telling(&self.camera, pose, params, &candidates, MAX_ASKED)
             }
         };
         ids.sort_unstable();
