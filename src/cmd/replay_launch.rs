@@ -48,6 +48,13 @@ pub fn prepare(recording: &Path, run_dir: &Path, rrd: bool, trust: bool) -> anyh
     Ok(path)
 }
 
+/// A `[[service]]` table's binary: its `binary`, else `harvey-<name>` (as the supervisor's
+/// `Service::binary` reads it from the typed file).
+pub(super) fn binary_of(s: &toml::Value) -> String {
+    let name = s.get("name").and_then(|n| n.as_str()).unwrap_or_default();
+    s.get("binary").and_then(|b| b.as_str()).map_or(format!("harvey-{name}"), str::to_owned)
+}
+
 /// The services of launch text `text` whose binary is not one of Harvey's own (named
 /// `harvey-<something>` and found beside the CLI or on the PATH, no path given), as
 /// `service (binary)`.
@@ -58,8 +65,7 @@ pub fn foreign_binaries(text: &str) -> anyhow::Result<Vec<String>> {
         .iter()
         .filter_map(|s| {
             let name = s.get("name").and_then(|n| n.as_str()).unwrap_or_default();
-            let binary =
-                s.get("binary").and_then(|b| b.as_str()).map_or(format!("harvey-{name}"), str::to_owned);
+            let binary = binary_of(s);
             let own = binary.starts_with("harvey-")
                 && binary.len() > "harvey-".len()
                 && binary.chars().all(|c| c.is_ascii_alphanumeric() || c == '-');
@@ -82,11 +88,7 @@ pub fn replay_launch(text: &str, recording: &Path, rrd: bool) -> anyhow::Result<
     launch.insert("clock".into(), "lockstep".into());
     launch.insert("clock_master".into(), "replayer".into());
     let services = doc.get_mut("service").and_then(|s| s.as_array_mut()).context("no [[service]]")?;
-    let is_input = |s: &toml::Value| {
-        let name = s.get("name").and_then(|n| n.as_str()).unwrap_or_default();
-        let binary = s.get("binary").and_then(|b| b.as_str()).map_or(format!("harvey-{name}"), str::to_owned);
-        INPUT_SERVICES.contains(&binary.as_str())
-    };
+    let is_input = |s: &toml::Value| INPUT_SERVICES.contains(&binary_of(s).as_str());
     let at =
         services.iter().position(is_input).context("no input service (simulated DRV, bridge, camera)")?;
     services.retain(|s| !is_input(s));

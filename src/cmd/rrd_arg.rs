@@ -2,11 +2,9 @@
 //! wanted (a sweep, a replay without `--rrd`), given where one is wanted of a recording made
 //! without it (a replay with `--rrd` of a sweep's run).
 
-/// Whether `s` is the recorder (its `binary`, else `harvey-<name>`).
+/// Whether `s` is the recorder.
 fn is_recorder(s: &toml::Value) -> bool {
-    let name = s.get("name").and_then(toml::Value::as_str).unwrap_or_default();
-    s.get("binary").and_then(toml::Value::as_str).map_or(format!("harvey-{name}"), str::to_owned)
-        == "harvey-recorder"
+    super::replay_launch::binary_of(s) == "harvey-recorder"
 }
 
 /// The recorder's arguments, if it has any.
