@@ -10,7 +10,8 @@ mod common;
 
 use std::collections::BTreeMap;
 
-use harvey_msgs::{Pose2, TruePose, VisionAlgorithm, VisionResult, VisionStatus};
+use common::truth::Truth;
+use harvey_msgs::{Pose2, VisionAlgorithm, VisionResult, VisionStatus};
 use harvey_world::Mover;
 
 /// The goal and the robot's radius (missions/depth-obstacles.toml, worlds/campus.toml).
@@ -77,15 +78,12 @@ fn true_depth(m: &Mover, pose: Pose2) -> f64 {
 
 fn figures(mcap: &[u8], movers: &[Mover]) -> Figures {
     let mut f = Figures::default();
-    let mut truth = Vec::<(u64, Pose2)>::new();
+    let mut truth = Truth::default();
     let mut results = Vec::new();
     for m in mcap::MessageStream::new(mcap).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
-            "/sim/truth" => {
-                let t = harvey_cdr::decode::<TruePose>(&m.data).expect("truth");
-                truth.push((t.header.stamp_ns, t.world_from_robot));
-            }
+            Truth::TOPIC => truth.push(&m),
             "/vision/results" => {
                 let r = harvey_cdr::decode::<VisionResult>(&m.data).expect("result");
                 if r.algorithm == VisionAlgorithm::Depth as u32 && r.status == VisionStatus::Found as u32 {
@@ -96,14 +94,15 @@ fn figures(mcap: &[u8], movers: &[Mover]) -> Figures {
         }
     }
     for m in movers {
-        let least = truth.iter().map(|(_, p)| to_footprint(m, [p.x_m, p.y_m])).fold(f64::INFINITY, f64::min);
+        let least =
+            truth.0.iter().map(|(_, p)| to_footprint(m, [p.x_m, p.y_m])).fold(f64::INFINITY, f64::min);
         f.clearance_m.insert(m.name.clone(), least - ROBOT_RADIUS_M);
     }
-    let last = truth.last().expect("truth").1;
+    let last = truth.last();
     f.end_m = (last.x_m - GOAL[0]).hypot(last.y_m - GOAL[1]);
     for r in &results {
         // Where the robot truly was when the frame was taken.
-        let Some(&(_, pose)) = truth.iter().rev().find(|(t, _)| *t <= r.header.stamp_ns) else { continue };
+        let Some(pose) = truth.at_or_before(r.header.stamp_ns) else { continue };
         for item in r.items[..r.count as usize].iter().skip(1) {
             let [u, _, z, sd, frames, class] = item.values.map(f64::from);
             let seen = pose.apply([z, -(u - CX) * z / FOCAL_PX]);

@@ -6,20 +6,19 @@
 
 mod common;
 
-use harvey_msgs::{BehaviourState, Pose2, TruePose};
+use common::truth::Truth;
+use harvey_msgs::BehaviourState;
 
 /// The behaviour's states, the acceptor's trace (each state once per visit) and the true poses.
-fn decode(out: &common::MissionRun) -> (Vec<BehaviourState>, Vec<u32>, Vec<Pose2>) {
-    let (mut states, mut truth) = (Vec::new(), Vec::new());
+fn decode(out: &common::MissionRun) -> (Vec<BehaviourState>, Vec<u32>, Truth) {
+    let (mut states, mut truth) = (Vec::new(), Truth::default());
     for m in mcap::MessageStream::new(&out.mcap).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
             "/executive/behaviour" => {
                 states.push(harvey_cdr::decode::<BehaviourState>(&m.data).expect("state"))
             }
-            "/sim/truth" => {
-                truth.push(harvey_cdr::decode::<TruePose>(&m.data).expect("truth").world_from_robot)
-            }
+            Truth::TOPIC => truth.push(&m),
             _ => {}
         }
     }
@@ -36,7 +35,7 @@ fn decode(out: &common::MissionRun) -> (Vec<BehaviourState>, Vec<u32>, Vec<Pose2
 fn docking_recovers_from_the_occluding_cart_and_ends_within_several_inches() {
     let out = common::run_mission("missions/docking.toml", "docking");
     let (states, trace, truth) = decode(&out);
-    let end = *truth.last().expect("truth");
+    let end = truth.last();
     let off_in = common::docked::off_mark_in(end);
     println!(
         "trace {trace:?}; ends {off_in:.2} in from the mark, heading {:.2} deg",
@@ -82,7 +81,7 @@ fn over_seeds_it_docks_within_several_inches() {
         for seed in 1..=3 {
             let out = common::run_mission_under("missions/docking.toml", condition, seed, "docks");
             let (_, trace, truth) = decode(&out);
-            let end = *truth.last().expect("truth");
+            let end = truth.last();
             let off_in = common::docked::off_mark_in(end);
             println!(
                 "{condition} s{seed}: trace {trace:?}; {off_in:.2} in from the mark, {:.1} deg",

@@ -9,7 +9,8 @@
 
 mod common;
 
-use harvey_msgs::{BehaviourState, Pose2, TruePose};
+use common::truth::Truth;
+use harvey_msgs::{BehaviourState, Pose2};
 
 /// What a run's recording says of it.
 #[derive(Debug)]
@@ -34,16 +35,13 @@ fn distance_to_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 
 fn figures(mcap: &[u8]) -> Figures {
     let world = harvey_world::load_str(include_str!("../worlds/room.toml"), "room").expect("world");
-    let mut truth: Vec<(u64, Pose2)> = Vec::new();
+    let mut truth = Truth::default();
     let mut looks: Vec<(u64, Pose2)> = Vec::new();
     let mut last: Option<BehaviourState> = None;
     for m in mcap::MessageStream::new(mcap).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
-            "/sim/truth" => {
-                let t = harvey_cdr::decode::<TruePose>(&m.data).expect("truth");
-                truth.push((t.header.stamp_ns, t.world_from_robot));
-            }
+            Truth::TOPIC => truth.push(&m),
             "/executive/behaviour" => {
                 let b = harvey_cdr::decode::<BehaviourState>(&m.data).expect("state");
                 // The model as each look left it (a look answered counts a stop).
@@ -55,19 +53,19 @@ fn figures(mcap: &[u8]) -> Figures {
             _ => {}
         }
     }
-    let at = |stamp: u64| truth.iter().rev().find(|(t, _)| *t <= stamp).map_or(truth[0].1, |(_, p)| *p);
     let last = last.expect("behaviour states");
-    let end = truth.last().expect("truth").1;
+    let end = truth.last();
     let steps: Vec<f64> = looks
         .windows(2)
         .map(|w| {
             let model = w[0].1.relative(&w[1].1);
-            let true_step = at(w[0].0).relative(&at(w[1].0));
+            let true_step = truth.at(w[0].0).relative(&truth.at(w[1].0));
             (model.x_m - true_step.x_m).hypot(model.y_m - true_step.y_m)
         })
         .collect();
     let radius = world.robot.sonar_ring_radius_m;
     let clearance = truth
+        .0
         .iter()
         .flat_map(|(_, p)| world.walls.iter().map(move |w| distance_to_segment([p.x_m, p.y_m], w.from, w.to)))
         .fold(f64::INFINITY, f64::min)

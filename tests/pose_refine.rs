@@ -10,25 +10,24 @@
 
 mod common;
 
+use common::truth::Truth;
 use harvey_geometry::INCH;
-use harvey_msgs::{PoseFix, TruePose};
+use harvey_msgs::PoseFix;
 
 /// Each fix's distance from the truth (in), after checking the run and each fix's belief.
 fn fix_errors_in(mission: &str, condition: &str, seed: u64) -> Vec<f64> {
     let out = common::run_mission_under(mission, condition, seed, "prefine");
     assert!(out.status.success() && out.stdout.contains("goal reached (4/4 steps)"), "{}", out.stdout);
-    let (mut fixes, mut truth) = (Vec::new(), None);
+    let (mut fixes, mut truth) = (Vec::new(), Truth::default());
     for m in mcap::MessageStream::new(&out.mcap).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
             "/executive/pose" => fixes.push(harvey_cdr::decode::<PoseFix>(&m.data).expect("fix")),
-            "/sim/truth" => {
-                truth = Some(harvey_cdr::decode::<TruePose>(&m.data).expect("truth").world_from_robot)
-            }
+            Truth::TOPIC => truth.push(&m),
             _ => {}
         }
     }
-    let t = truth.expect("truth");
+    let t = truth.last();
     assert_eq!(fixes.len(), 4, "one refinement per step");
     let off = |p: harvey_msgs::Pose2| (p.x_m - t.x_m).hypot(p.y_m - t.y_m) / INCH;
     // Each step moves the belief sideways from the last fix's pose (the first, from where the

@@ -6,19 +6,15 @@
 
 mod common;
 
+use common::truth::Truth;
 use harvey_geometry::INCH;
-use harvey_msgs::{CheckOutcome, PlanSketch, PlanStage, Pose2, PoseFix, TruePose, UncertaintyMap};
-
-/// The true pose at (or just before) `stamp_ns`.
-fn truth_at(truth: &[(u64, Pose2)], stamp_ns: u64) -> Pose2 {
-    let k = truth.partition_point(|t| t.0 <= stamp_ns);
-    truth[k.saturating_sub(1)].1
-}
+use harvey_msgs::{CheckOutcome, PlanSketch, PlanStage, PoseFix, UncertaintyMap};
 
 #[test]
 fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
     let out = common::run_mission("missions/ptrans.toml", "ptrans");
-    let (mut fixes, mut truth, mut plans, mut lost_in_lab) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut fixes, mut truth, mut plans, mut lost_in_lab) =
+        (Vec::new(), Truth::default(), Vec::new(), Vec::new());
     for m in mcap::MessageStream::new(&out.mcap).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
@@ -26,20 +22,17 @@ fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
             "/executive/plan" => plans.push(harvey_cdr::decode::<PlanSketch>(&m.data).expect("plan")),
             "/ums/map" => {
                 let map = harvey_cdr::decode::<UncertaintyMap>(&m.data).expect("map");
-                let in_lab = truth.last().is_some_and(|t: &(u64, Pose2)| t.1.y_m > 1.1 && t.1.x_m < 8.0);
+                let in_lab = truth.0.last().is_some_and(|t| t.1.y_m > 1.1 && t.1.x_m < 8.0);
                 if in_lab && map.lost == 1 {
                     lost_in_lab.push(map.header.stamp_ns as f64 / 1e9);
                 }
             }
-            "/sim/truth" => {
-                let t = harvey_cdr::decode::<TruePose>(&m.data).expect("truth");
-                truth.push((t.header.stamp_ns, t.world_from_robot));
-            }
+            Truth::TOPIC => truth.push(&m),
             _ => {}
         }
     }
     for f in &fixes {
-        let t = truth_at(&truth, f.header.stamp_ns);
+        let t = truth.at(f.header.stamp_ns);
         println!(
             "fix at t={:.2}s: truth ({:.3}, {:.3}, {:.2} deg) expected {:.2} in off, refined {:.2} in off, heading {:+.2} deg ({} of {} kept, {:.2} px)",
             f.header.stamp_ns as f64 / 1e9,
@@ -61,6 +54,7 @@ fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
     // The true path crossed the north wall's line (y = 1) in the lab's doorway, going out, and
     // in the office's, going in, and nowhere else.
     let crossings: Vec<(f64, bool)> = truth
+        .0
         .windows(2)
         .filter(|w| (w[0].1.y_m - 1.0).signum() != (w[1].1.y_m - 1.0).signum())
         .map(|w| (w[1].1.x_m, w[1].1.y_m > 1.0))
@@ -79,7 +73,7 @@ fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
     assert!(fixes.len() >= 5, "{} fixes", fixes.len());
     let mut strong = Vec::new();
     for f in &fixes {
-        let t = truth_at(&truth, f.header.stamp_ns);
+        let t = truth.at(f.header.stamp_ns);
         let off_in = (f.refined.x_m - t.x_m).hypot(f.refined.y_m - t.y_m) / INCH;
         assert!(off_in < 10.0, "a fix {off_in:.2} in off: {f:?}");
         if f.kept >= 8 {
@@ -100,7 +94,7 @@ fn ptrans_from_the_robot_lab_ends_within_an_inch_of_teds_desk() {
     // The last check: within the goal's 0.5 in, or within two of its fix's standard deviations
     // (a few cm: no further move can do better than the fix tells).
     assert!(last.checks >= 6 && last.last_off_m <= 0.1, "{last:?}");
-    let end = truth.last().expect("truth").1;
+    let end = truth.last();
     let off_in = (end.x_m - 12.0).hypot(end.y_m - 2.5) / INCH;
     println!("ends {off_in:.2} in from the goal, heading {:.2} deg", end.heading_rad.to_degrees());
     assert!(off_in < 1.0, "ends {off_in:.2} in from the goal");

@@ -4,6 +4,7 @@
 
 pub mod docked;
 pub mod sweeps;
+pub mod truth;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command};
