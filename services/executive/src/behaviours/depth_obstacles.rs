@@ -223,19 +223,29 @@ impl DepthObstacles {
                 .filter(|(_, d)| *d <= self.robot_radius_m + g.sonar_reach_m);
             points.extend(near.map(|(b, d)| [here.x + d * b.cos(), here.y + d * b.sin()]));
         }
-        let avoid =
-            nearest_of_each(&points, [here.x, here.y], g.link_m).into_iter().fold(V2::default(), |v, p| {
-                v.plus(avoid_obstacle(
-                    here,
-                    V2::new(p[0], p[1]),
-                    reach,
-                    g.sphere_m,
-                    g.avoid_gain,
-                    CONTACT_GAIN,
-                ))
-            });
+        let push_at = |at: V2| {
+            nearest_of_each(&points, [at.x, at.y], g.link_m).into_iter().fold(V2::default(), |v, p| {
+                v.plus(avoid_obstacle(at, V2::new(p[0], p[1]), reach, g.sphere_m, g.avoid_gain, CONTACT_GAIN))
+            })
+        };
+        let avoid = push_at(here);
         let sum = to_goal.plus(avoid);
         self.vectors = [to_goal, avoid, sum];
+        // A guarded goal: where the obstacles beside it push harder than it pulls, the schemas
+        // cannot bring the robot there (their sum turns back before it). Once the robot is within
+        // the obstacles' reach of the goal and their sum points away from it, it is as near as
+        // they let it come: arrived (nominal seed 10 turned back and forth 0.8 m off for 200 s).
+        let gap = goal.minus(here).norm();
+        let stalled = sum.x * to_goal.x + sum.y * to_goal.y <= 0.0;
+        if stalled && gap <= reach + g.sphere_m && push_at(goal).norm() >= to_goal.norm() {
+            tracing::info!(
+                looks = self.looks,
+                gap_m = gap,
+                "as near the goal as the obstacles by it let the robot come"
+            );
+            self.done = Some(true);
+            return;
+        }
         // Never further round than `max_detour_deg` from the goal: an obstacle dead ahead pushes
         // the sum backwards, and the robot would turn about at every stop; it slides past.
         let goal_dir = to_goal.y.atan2(to_goal.x);
@@ -296,3 +306,7 @@ impl DepthObstacles {
 
 #[path = "depth_steps.rs"]
 mod steps;
+
+#[cfg(test)]
+#[path = "depth_obstacles_tests.rs"]
+mod tests;
