@@ -129,7 +129,7 @@ fn over_seeds_the_goal_is_reached_within_the_budget() {
                 // 000 §5's inch, where the map is the world.
                 assert!(off_in < 1.0, "{condition} s{seed}: {off_in:.2} in");
             } else {
-                // Seeds 1..10 of the nominal sweep ended at most 4.1 in off (docs/evaluation.md).
+                // Seeds 1..12 of the nominal sweep ended at most 2.6 in off (docs/evaluation.md).
                 assert!(off_in < 6.0, "{condition} s{seed}: {off_in:.2} in");
                 nominal.push(off_in);
             }

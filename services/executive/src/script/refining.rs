@@ -7,12 +7,8 @@ use harvey_msgs::{Header, Pose2, PoseFix, VisionRequest, VisionResult, VisionSta
 
 use super::{Phase, Script, Sequel};
 use crate::Output;
-use crate::servo::pose::{VertexMatch, refine};
+use crate::servo::pose::{SURPRISE_LIMIT, VertexMatch, refine};
 use crate::servo::vertices::MIN_ASKED;
-
-/// A fix that moves the pose further from the expected one than this (chi-square, three degrees
-/// of freedom, 0.999) says more about false matches than about the robot: refused.
-const SURPRISE_LIMIT: f64 = 16.27;
 
 /// Results not in this long (ns) after the requests are taken as not found.
 pub const WAIT_NS: u64 = 2_000_000_000;
@@ -30,7 +26,7 @@ impl Script {
         let expected = self.estimated;
         let c = setup.camera.centre_px;
         // Chosen for the prior the fix will have: what dead reckoning since the last fix leaves.
-        let params = setup.growth.widen(&setup.params, self.belief.travelled_m());
+        let params = setup.prior(&self.belief);
         self.asked = setup.in_view(expected, [2.0 * c[0], 2.0 * c[1]], &params);
         if self.asked.len() < MIN_ASKED {
             tracing::info!(in_view = self.asked.len(), "too few landmark vertices in view for a pose fix");
@@ -91,7 +87,7 @@ impl Script {
             .collect();
         let expected = self.estimated;
         // The prior is what dead reckoning since the last fix leaves of the pose.
-        let params = setup.growth.widen(&setup.params, self.belief.travelled_m());
+        let params = setup.prior(&self.belief);
         let mut out = Vec::new();
         match refine(&setup.camera, expected, &matches, &params) {
             // Too few matches agreeing: no fix (a pose from two vertices fits anything).

@@ -10,19 +10,27 @@ pub struct Belief {
     odometry: Pose2,
     fix: Option<(Pose2, Pose2)>,
     travelled_m: f64,
+    /// The turn odometry measured since the last fix, either way (rad).
+    turned_rad: f64,
 }
 
 impl Belief {
     /// Odometry's latest pose.
     pub fn set_odometry(&mut self, odometry: Pose2) {
         self.travelled_m += (odometry.x_m - self.odometry.x_m).hypot(odometry.y_m - self.odometry.y_m);
+        self.turned_rad += harvey_geometry::wrap(odometry.heading_rad - self.odometry.heading_rad).abs();
         self.odometry = odometry;
     }
 
     /// The robot is at `pose` now (odometry's latest pose is the one it goes with).
     pub fn fix(&mut self, pose: Pose2) {
         self.fix = Some((self.odometry, pose));
-        self.travelled_m = 0.0;
+        (self.travelled_m, self.turned_rad) = (0.0, 0.0);
+    }
+
+    /// The turn odometry measured since the last fix, either way (rad).
+    pub fn turned_rad(&self) -> f64 {
+        self.turned_rad
     }
 
     /// The path odometry measured since the last fix (since the start without one), m.

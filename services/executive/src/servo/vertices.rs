@@ -38,14 +38,16 @@ pub enum Choose {
     MostTelling,
 }
 
-/// How much less the believed pose is worth per metre travelled since the last fix, from the
-/// world's terrain statistics (002 §3.2 Table 3; the worst terrain of the world): the heading
-/// drifts by `drift + sd` degrees a foot (its sign unknown to the robot, as the UMS takes it), the
-/// distance falls short by `loss + sd` of itself, and the heading's drift moves the robot
-/// sideways by half of itself times the distance.
+/// How much less the believed pose is worth per metre travelled and per radian turned since the
+/// last fix, from the world's terrain statistics (002 §3.2 Table 3; the worst terrain of the
+/// world): the heading drifts by `drift + sd` degrees a foot (its sign unknown to the robot, as
+/// the UMS takes it) and a turn falls short by `loss + sd` of itself, the distance falls short
+/// by `loss + sd` of itself, and the heading's drift moves the robot sideways by half of itself
+/// times the distance.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Growth {
     pub heading_rad_per_m: f64,
+    pub heading_per_turn: f64,
     pub along_per_m: f64,
 }
 
@@ -57,14 +59,19 @@ impl Growth {
             heading_rad_per_m: g
                 .heading_rad_per_m
                 .max(((t.drift_deg_per_ft + t.drift_sd_deg_per_ft) * ft_per_m).to_radians()),
+            heading_per_turn: g
+                .heading_per_turn
+                .max(t.rotational_loss_deg_per_deg + t.rotational_sd_deg_per_deg),
             along_per_m: g.along_per_m.max(t.translational_loss_ft_per_ft + t.translational_sd_ft_per_ft),
         })
     }
 
-    /// `params` with its prior widened for `travelled_m` of dead reckoning.
-    pub fn widen(&self, params: &RefineParams, travelled_m: f64) -> RefineParams {
-        let heading = self.heading_rad_per_m * travelled_m;
-        let position = (self.along_per_m * travelled_m).max(heading * travelled_m / 2.0);
+    /// `params` with its prior widened for `travelled_m` of dead reckoning and `turned_rad` of
+    /// turns.
+    pub fn widen(&self, params: &RefineParams, travelled_m: f64, turned_rad: f64) -> RefineParams {
+        let drift = self.heading_rad_per_m * travelled_m;
+        let heading = drift + self.heading_per_turn * turned_rad;
+        let position = (self.along_per_m * travelled_m).max(drift * travelled_m / 2.0);
         let [x, y, h] = params.prior_sd;
         RefineParams { prior_sd: [x.hypot(position), y.hypot(position), h.hypot(heading)], ..*params }
     }
@@ -76,6 +83,12 @@ pub const MAX_ASKED: usize = 16;
 pub const MIN_ASKED: usize = 3;
 
 impl RefineSetup {
+    /// The prior of a fix taken with `belief` as it stands: the configured one, widened by the
+    /// travel and turns since the last fix.
+    pub fn prior(&self, belief: &crate::servo::belief::Belief) -> RefineParams {
+        self.growth.widen(&self.params, belief.travelled_m(), belief.turned_rad())
+    }
+
     /// The vertices (indices) worth asking for from `pose`: in the image clear of its edges by a
     /// template, 0.5 to 20 m ahead, with no wall between; of those, `MAX_ASKED` by `choose`
     /// (the most telling for a fix with `params`' priors), in list order.
@@ -124,18 +137,46 @@ mod tests {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../worlds/hallway.toml");
         let world = harvey_world::World::load(std::path::Path::new(path)).expect("world");
         let g = Growth::of(&world);
-        let p = RefineParams {
-            prior_sd: [0.3, 0.3, 0.05],
-            pitch_sd_rad: 0.0,
-            image_sd_px: 0.5,
-            map_sd_m: 0.0,
-            gate_px: 3.0,
-        };
-        assert_eq!(g.widen(&p, 0.0), p, "no travel, no change");
+        let p = crate::servo::pose::tests::params();
+        assert_eq!(g.widen(&p, 0.0, 0.0), p, "no travel, no change");
         // A 7 m leg on concrete (the worst): (0.30 + 0.14) deg/ft for 23 ft is 10 deg of heading,
         // and 0.6 m sideways from half of it.
-        let w = g.widen(&p, 7.0);
-        assert!((w.prior_sd[2].to_degrees() - 0.05f64.to_degrees().hypot(10.1)).abs() < 0.1, "{w:?}");
+        let w = g.widen(&p, 7.0, 0.0);
+        assert!((w.prior_sd[2].to_degrees() - p.prior_sd[2].to_degrees().hypot(10.1)).abs() < 0.1, "{w:?}");
         assert!(w.prior_sd[0] > 0.6 && w.prior_sd[1] == w.prior_sd[0], "{w:?}");
+    }
+
+    #[test]
+    fn a_turn_since_the_last_fix_widens_the_heading_s_prior_and_a_fix_starts_it_afresh() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../worlds/hallway.toml");
+        let world = harvey_world::World::load(std::path::Path::new(path)).expect("world");
+        let params = crate::servo::pose::tests::params();
+        let setup = RefineSetup {
+            vertices: Vec::new(),
+            camera: crate::servo::pose::tests::cam(),
+            params,
+            template_px: 16,
+            min_score: 0.9,
+            max_sd_m: f64::INFINITY,
+            growth: Growth::of(&world),
+            world: None,
+            choose: Choose::Nearest,
+        };
+        let mut belief = crate::servo::belief::Belief::default();
+        assert_eq!(setup.prior(&belief), params, "nothing done yet: the configured prior");
+        // A quarter turn on the spot: Table 3's rotational loss and spread of the turn (tile's
+        // 0.018 + 0.006, the worst) join the heading's spread; no travel, no position lost.
+        let quarter = std::f64::consts::FRAC_PI_2;
+        belief.set_odometry(Pose2 { x_m: 0.0, y_m: 0.0, heading_rad: quarter });
+        let turned = setup.prior(&belief).prior_sd;
+        assert!((turned[2] - params.prior_sd[2].hypot(0.024 * quarter)).abs() < 1e-9, "{turned:?}");
+        assert_eq!(turned[..2], params.prior_sd[..2]);
+        // Back the other way: a turn counts either way.
+        belief.set_odometry(Pose2::default());
+        let back = setup.prior(&belief).prior_sd;
+        assert!((back[2] - params.prior_sd[2].hypot(0.048 * quarter)).abs() < 1e-9, "{back:?}");
+        // A fix starts the count afresh.
+        belief.fix(Pose2::default());
+        assert_eq!(setup.prior(&belief), params);
     }
 }
