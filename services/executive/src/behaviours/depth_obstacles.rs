@@ -231,13 +231,17 @@ impl DepthObstacles {
         let avoid = push_at(here);
         let sum = to_goal.plus(avoid);
         self.vectors = [to_goal, avoid, sum];
-        // A guarded goal: where the obstacles beside it push harder than it pulls, the schemas
-        // cannot bring the robot there (their sum turns back before it). Once the robot is within
-        // the obstacles' reach of the goal and their sum points away from it, it is as near as
-        // they let it come: arrived (nominal seed 10 turned back and forth 0.8 m off for 200 s).
+        // A guarded goal: where the obstacles by it push back along the approach harder than it
+        // pulls, the schemas cannot bring the robot there (their sum turns back before it). Once
+        // the robot is within the obstacles' reach of the goal and their sum points away from
+        // it, it is as near as they let it come: arrived (nominal seed 10 turned back and forth
+        // 0.8 m off for 200 s). An obstacle between the robot and the goal pushes the goal's way
+        // at the goal: that one the robot slides past (the detour below).
         let gap = goal.minus(here).norm();
-        let stalled = sum.x * to_goal.x + sum.y * to_goal.y <= 0.0;
-        if stalled && gap <= reach + g.sphere_m && push_at(goal).norm() >= to_goal.norm() {
+        let dot = |a: V2, b: V2| a.x * b.x + a.y * b.y;
+        let stalled = dot(sum, to_goal) <= 0.0;
+        let back_at_goal = -dot(push_at(goal), to_goal.unit());
+        if stalled && gap <= reach + g.sphere_m && back_at_goal >= to_goal.norm() {
             tracing::info!(
                 looks = self.looks,
                 gap_m = gap,
