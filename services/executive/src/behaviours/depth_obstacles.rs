@@ -238,9 +238,8 @@ impl DepthObstacles {
         // 0.8 m off for 200 s). An obstacle between the robot and the goal pushes the goal's way
         // at the goal: that one the robot slides past (the detour below).
         let gap = goal.minus(here).norm();
-        let dot = |a: V2, b: V2| a.x * b.x + a.y * b.y;
-        let stalled = dot(sum, to_goal) <= 0.0;
-        let back_at_goal = -dot(push_at(goal), to_goal.unit());
+        let stalled = sum.dot(to_goal) <= 0.0;
+        let back_at_goal = -push_at(goal).dot(to_goal.unit());
         if stalled && gap <= reach + g.sphere_m && back_at_goal >= to_goal.norm() {
             tracing::info!(
                 looks = self.looks,

@@ -348,7 +348,7 @@ impl Docking {
         let n = self.g.dock_facing_deg.to_radians();
         let n = V2::new(n.cos(), n.sin());
         let out = here.minus(target);
-        let along = out.x * n.x + out.y * n.y;
+        let along = out.dot(n);
         let goal = target.plus(n.scale((along - self.g.lead_m).max(self.g.final_m)));
         // ...but never so far off the target that it would leave the image.
         let to_goal = goal.minus(here);

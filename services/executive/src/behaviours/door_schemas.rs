@@ -46,7 +46,7 @@ pub(crate) fn slide(d: &mut DoorFinding, parts: &mut [V2; 5]) -> (f64, f64) {
     parts[1] = unit(into).scale(d.g.press_mps);
     parts[2] = avoid(d);
     let u = unit(into);
-    let pushed = -(parts[2].x * u.x + parts[2].y * u.y) >= d.g.press_mps / 2.0;
+    let pushed = -parts[2].dot(u) >= d.g.press_mps / 2.0;
     let sum = drive::vectors(*parts, &d.drive).sum;
     let turned = d.side * wrap(sum.y.atan2(sum.x) - along);
     let drawn = sum.norm() > 1e-6 && turned >= d.g.drawn_in_deg.to_radians();

@@ -34,6 +34,11 @@ impl V2 {
         Self::new(self.x - o.x, self.y - o.y)
     }
 
+    /// The dot product: this one's length along `o`, times `o`'s.
+    pub fn dot(self, o: Self) -> f64 {
+        self.x * o.x + self.y * o.y
+    }
+
     /// The unit vector along this one (zero stays zero).
     pub fn unit(self) -> Self {
         let n = self.norm();
