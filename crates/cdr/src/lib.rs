@@ -18,4 +18,4 @@ pub use dynamic::{Schema, SchemaError};
 pub use geometry::{Point, Quaternion, TfMessage, Transform};
 pub use marker::{Colour, Marker, MarkerArray, MarkerKind};
 pub use schema::{Def, full_text};
-pub use types::{Ros2Msg, decode_image, encode_image, image_def};
+pub use types::{Ros2Msg, decode_image, decode_image_head, encode_image, image_def};

@@ -80,11 +80,24 @@ pub fn encode_image(h: &FrameHeader, pixels: &[u8], buf: Vec<u8>) -> Vec<u8> {
 /// Decodes a `sensor_msgs/msg/Image` back to a frame header (sequence number 0: the standard
 /// type has none) and its pixels, borrowed from `data`.
 pub fn decode_image(data: &[u8]) -> Result<(FrameHeader, &[u8]), CdrError> {
-    let mut r = CdrReader::new(data)?;
+    let (h, at) = decode_image_head(data)?;
+    let pixels = data
+        .get(at..at + h.payload_len())
+        .ok_or(CdrError::Truncated { at, needed: (at + h.payload_len()).saturating_sub(data.len()) })?;
+    Ok((h, pixels))
+}
+
+/// Reads the fields of a `sensor_msgs/msg/Image` before its pixels from `prefix`, the message's
+/// first bytes (the pixels need not follow): the frame header, checked against the pixel count
+/// the message declares, and the offset at which its `payload_len()` pixel bytes start. For a
+/// message that arrives in pieces (a Zenoh sample of many fragments), whose pixels are then
+/// copied piece by piece instead of being gathered first.
+pub fn decode_image_head(prefix: &[u8]) -> Result<(FrameHeader, usize), CdrError> {
+    let mut r = CdrReader::new(prefix)?;
     let sec = r.prim::<i32>()?;
     let nanosec = r.prim::<u32>()?;
     let frame_id = r.string()?;
-    let at = data.len() - r.remaining();
+    let at = r.offset();
     let rows = r.prim::<u32>()?;
     let views = if frame_id == frames::STEREO_PAIR { 2 } else { 1 };
     if rows % views != 0 {
@@ -95,13 +108,14 @@ pub fn decode_image(data: &[u8]) -> Result<(FrameHeader, &[u8]), CdrError> {
     }
     let height_px = rows / views;
     let width_px = r.prim::<u32>()?;
-    let at = data.len() - r.remaining();
+    let at = r.offset();
     let encoding = r.string()?;
     let enc = harvey_msgs::Encoding::parse(&encoding)
         .ok_or(CdrError::Invalid { at, what: format!("image encoding `{encoding}` is not mono8 or rgb8") })?;
     let _bigendian = r.prim::<u8>()?;
     let stride_bytes = r.prim::<u32>()?;
-    let pixels = r.byte_seq()?;
+    let at = r.offset();
+    let len = r.prim::<u32>()? as usize;
     let stamp_ns = u64::try_from(sec).unwrap_or(0) * 1_000_000_000 + u64::from(nanosec);
     let h = FrameHeader {
         seq: 0,
@@ -113,13 +127,13 @@ pub fn decode_image(data: &[u8]) -> Result<(FrameHeader, &[u8]), CdrError> {
         views,
         reserved: 0,
     };
-    if pixels.len() != h.payload_len() {
+    if len != h.payload_len() {
         return Err(CdrError::Invalid {
             at,
-            what: format!("{} pixel bytes for a {width_px}x{rows} {encoding} image", pixels.len()),
+            what: format!("{len} pixel bytes for a {width_px}x{rows} {encoding} image"),
         });
     }
-    Ok((h, pixels))
+    Ok((h, r.offset()))
 }
 
 macro_rules! ros2_struct {

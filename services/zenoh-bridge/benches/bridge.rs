@@ -70,7 +70,7 @@ fn peer(listen: Option<&str>, connect: Option<&str>) -> zenoh::Session {
 }
 
 /// Raw Zenoh: a publisher session and a subscriber session joined on loopback.
-fn raw(bytes: usize, rounds: usize) -> Row {
+fn raw(bytes: usize, rounds: usize, window: u64) -> Row {
     let at = format!("tcp/127.0.0.1:{}", free_port());
     let subscriber_side = peer(Some(&at), None);
     let publisher_side = peer(None, Some(&at));
@@ -95,15 +95,19 @@ fn raw(bytes: usize, rounds: usize) -> Row {
     }
     while rx.try_recv().is_ok() {}
     let (mut lat, start) = (Vec::with_capacity(rounds), Instant::now());
+    let mut sent = 0u64;
     for round in 0..rounds as u64 {
-        fill(&mut buf, round);
-        buf[..8].copy_from_slice(&now_ns().to_le_bytes());
-        publisher.put(buf.clone()).wait().unwrap();
+        while sent < rounds as u64 && sent < round + window {
+            fill(&mut buf, sent);
+            buf[..8].copy_from_slice(&now_ns().to_le_bytes());
+            publisher.put(buf.clone()).wait().unwrap();
+            sent += 1;
+        }
         let got = rx.recv_timeout(Duration::from_secs(10)).expect("raw frame");
         let t = now_ns();
-        let sent = u64::from_le_bytes(got[..8].try_into().unwrap());
+        let stamp = u64::from_le_bytes(got[..8].try_into().unwrap());
         assert_eq!((got.len(), got[bytes - 1]), (bytes, (round % 251) as u8));
-        lat.push(t - sent);
+        lat.push(t - stamp);
     }
     Row { lat, mb_s: (bytes * rounds) as f64 / start.elapsed().as_secs_f64() / 1e6 }
 }
@@ -131,7 +135,7 @@ fn bridge(prefix: &str, args: &[&str]) -> Bridge {
 }
 
 /// Harvey: domain A -> bridge A -> Zenoh -> bridge B -> domain B.
-fn harvey(bytes: usize, (w, h, enc): (u32, u32, Encoding), rounds: usize, tag: &str) -> Row {
+fn harvey(bytes: usize, (w, h, enc): (u32, u32, Encoding), rounds: usize, window: u64, tag: &str) -> Row {
     let (pa, pb) =
         (format!("zbench{tag}a{}_", std::process::id()), format!("zbench{tag}b{}_", std::process::id()));
     let at = format!("tcp/127.0.0.1:{}", free_port());
@@ -152,11 +156,15 @@ fn harvey(bytes: usize, (w, h, enc): (u32, u32, Encoding), rounds: usize, tag: &
         std::thread::sleep(Duration::from_millis(50));
     }
     let (mut lat, start) = (Vec::with_capacity(rounds), Instant::now());
+    let mut sent = 0u64;
     for round in 0..rounds as u64 {
-        let mut loan = frames.loan(FrameHeader::new(round, 0, w, h, enc)).unwrap();
-        fill(loan.pixels_mut(), round);
-        loan.set_header(FrameHeader::new(round, now_ns(), w, h, enc));
-        loan.send().unwrap();
+        while sent < rounds as u64 && sent < round + window {
+            let mut loan = frames.loan(FrameHeader::new(sent, 0, w, h, enc)).unwrap();
+            fill(loan.pixels_mut(), sent);
+            loan.set_header(FrameHeader::new(sent, now_ns(), w, h, enc));
+            loan.send().unwrap();
+            sent += 1;
+        }
         let frame = loop {
             if let Some(f) = frames_b.take().unwrap() {
                 break f;
@@ -165,6 +173,7 @@ fn harvey(bytes: usize, (w, h, enc): (u32, u32, Encoding), rounds: usize, tag: &
         };
         let t = now_ns();
         let px = frame.pixels();
+        assert_eq!(frame.header().seq, round, "a frame lost or out of order");
         assert_eq!((px.len(), px[0], px[bytes - 1]), (bytes, (round % 251) as u8, (round % 251) as u8));
         lat.push(t - frame.header().stamp_ns);
     }
@@ -183,34 +192,49 @@ fn main() {
         harvey_vision::simd::cpu_model(),
         harvey_vision::simd::cpu_features()
     );
-    println!("| stream | path | p50 µs | p99 µs | MB/s | p50 / raw | MB/s / raw |");
-    println!("|---|---|---:|---:|---:|---:|---:|");
+    println!(
+        "| stream | path | p50 µs | p99 µs | MB/s, one at a time | MB/s, two in flight | p50 / raw | MB/s / raw (two in flight) |"
+    );
+    println!("|---|---|---:|---:|---:|---:|---:|---:|");
     let streams = [
-        ("640x480 mono8", (640, 480, Encoding::Mono8), 300),
-        ("1920x1080 rgb8", (1920, 1080, Encoding::Rgb8), 100),
+        ("640x480 mono8", (640, 480, Encoding::Mono8), 1000),
+        ("1920x1080 rgb8", (1920, 1080, Encoding::Rgb8), 200),
     ];
+    let only = std::env::var("BRIDGE_BENCH_ONLY").ok();
     for (name, (w, h, enc), rounds) in streams {
-        let bytes = (w * h * if enc == Encoding::Rgb8 { 3 } else { 1 }) as usize;
-        // Interleaved, twice each: the machine is shared.
-        let mut raws = Vec::new();
-        let mut harveys = Vec::new();
-        for i in 0..2 {
-            raws.push(raw(bytes, rounds));
-            harveys.push(harvey(bytes, (w, h, enc), rounds, &format!("{}{i}", w)));
+        if only.as_deref().is_some_and(|o| !name.starts_with(o)) {
+            continue;
         }
-        let merge = |rows: Vec<Row>| {
+        let bytes = (w * h * if enc == Encoding::Rgb8 { 3 } else { 1 }) as usize;
+        // [raw, Harvey] x [one at a time, two in flight], interleaved, twice each: the machine
+        // is shared.
+        let mut rows: [[Vec<Row>; 2]; 2] = Default::default();
+        for i in 0..2 {
+            for (k, window) in [1, 2].into_iter().enumerate() {
+                rows[0][k].push(raw(bytes, rounds, window));
+                rows[1][k].push(harvey(bytes, (w, h, enc), rounds, window, &format!("{w}{i}{window}")));
+            }
+        }
+        let merge = |rows: &mut Vec<Row>| {
             let mb_s = rows.iter().map(|r| r.mb_s).sum::<f64>() / rows.len() as f64;
-            Row { lat: rows.into_iter().flat_map(|r| r.lat).collect(), mb_s }
+            Row { lat: rows.drain(..).flat_map(|r| r.lat).collect(), mb_s }
         };
-        let (r, hv) = (merge(raws), merge(harveys));
-        println!("| {name} | raw Zenoh | {:.0} | {:.0} | {:.0} | 1.00 | 1.00 |", r.p(0.5), r.p(0.99), r.mb_s);
+        let [[r1, r2], [h1, h2]] = rows.each_mut().map(|pair| pair.each_mut().map(merge));
         println!(
-            "| {name} | Harvey: bus, two bridges, bus | {:.0} | {:.0} | {:.0} | {:.2} | {:.2} |",
-            hv.p(0.5),
-            hv.p(0.99),
-            hv.mb_s,
-            hv.p(0.5) / r.p(0.5),
-            hv.mb_s / r.mb_s
+            "| {name} | raw Zenoh | {:.0} | {:.0} | {:.0} | {:.0} | 1.00 | 1.00 |",
+            r1.p(0.5),
+            r1.p(0.99),
+            r1.mb_s,
+            r2.mb_s
+        );
+        println!(
+            "| {name} | Harvey: bus, two bridges, bus | {:.0} | {:.0} | {:.0} | {:.0} | {:.2} | {:.2} |",
+            h1.p(0.5),
+            h1.p(0.99),
+            h1.mb_s,
+            h2.mb_s,
+            h1.p(0.5) / r1.p(0.5),
+            h2.mb_s / r2.mb_s
         );
     }
 }

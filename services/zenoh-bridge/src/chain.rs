@@ -242,7 +242,7 @@ impl<'a> Chain<'a> {
                 item.meta.fingerprint,
                 sink.fingerprint()
             );
-            sink.publish(&item.meta, item.cdr)
+            sink.publish(&item.meta, &[item.cdr])
                 .map_err(|e| anyhow::anyhow!("{} from host {}: {e}", item.topic, self.peer))?;
             if let Some(t) = tick {
                 self.keep.published(t, i)?;

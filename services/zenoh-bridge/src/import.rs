@@ -72,7 +72,8 @@ impl Importer {
                     continue;
                 }
             };
-            match sink.publish(&meta, &a.payload.to_bytes()) {
+            let pieces: Vec<&[u8]> = a.payload.slices().collect();
+            match sink.publish(&meta, &pieces) {
                 Ok(()) => {
                     count.published += 1;
                     n += 1;
