@@ -32,14 +32,13 @@ pub fn check_endpoints(listen: &[String], connect: &[String]) -> anyhow::Result<
     for (flag, e) in
         listen.iter().map(|e| ("--zenoh-listen", e)).chain(connect.iter().map(|e| ("--zenoh-connect", e)))
     {
-        let addr =
-            e.strip_prefix("tcp/").ok_or_else(|| anyhow::anyhow!("{flag} {e}: not `tcp/HOST:PORT`"))?;
+        let addr = harvey_runtime::endpoint::tcp_address(flag, e)?;
         use std::net::ToSocketAddrs;
         let at = addr
             .to_socket_addrs()
             .ok()
             .and_then(|mut a| a.next())
-            .ok_or_else(|| anyhow::anyhow!("{flag} {e}: not `tcp/HOST:PORT`"))?;
+            .ok_or_else(|| anyhow::anyhow!("{flag} {e}: no address found for `{addr}`"))?;
         if flag == "--zenoh-listen" && at.port() != 0 {
             std::net::TcpListener::bind(at)
                 .map_err(|err| anyhow::anyhow!("{flag} {e}: cannot listen there: {err}"))?;

@@ -12,6 +12,12 @@ pub const PREFIX_ENV: &str = "HARVEY_IPC_PREFIX";
 /// Prefix used when no other is given.
 pub const DEFAULT_PREFIX: &str = "harvey_";
 
+/// Whether `name` is plain: not empty, ASCII letters, digits, `-` and `_` only (a bus prefix, a
+/// service's or a host's name).
+pub fn is_plain_name(name: &str) -> bool {
+    !name.is_empty() && name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-')
+}
+
 /// Checks that a prefix can name shared-memory objects and files: 1–40 ASCII letters, digits,
 /// `_` or `-`.
 pub fn validate_prefix(prefix: &str) -> Result<()> {
@@ -19,7 +25,7 @@ pub fn validate_prefix(prefix: &str) -> Result<()> {
     if prefix.is_empty() || prefix.len() > 40 {
         return bad("must be 1 to 40 characters long");
     }
-    if !prefix.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'_' || b == b'-') {
+    if !is_plain_name(prefix) {
         return bad("only ASCII letters, digits, `_` and `-` are allowed");
     }
     Ok(())

@@ -23,7 +23,8 @@ mod waiter;
 
 pub use clock::{AFTER_ENV, CLOCK_ENV, Lockstep, PARTY_ENV, Pace, Step, lockstep_from_env};
 pub use domain::{
-    Bus, DEFAULT_PREFIX, NodeInfo, PREFIX_ENV, cleanup_dead_nodes, live_nodes, retire_domain, validate_prefix,
+    Bus, DEFAULT_PREFIX, NodeInfo, PREFIX_ENV, cleanup_dead_nodes, is_plain_name, live_nodes, retire_domain,
+    validate_prefix,
 };
 pub use error::BusError;
 pub use frames::{Frame, FrameLoan, FramePublisher, FrameSubscriber};

@@ -8,6 +8,7 @@
 //! started by hand (no variable) skips the handshake.
 
 pub mod checkpoint;
+pub mod endpoint;
 pub mod journal;
 pub mod node;
 pub mod resume;

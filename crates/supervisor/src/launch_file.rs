@@ -88,7 +88,7 @@ impl LaunchFile {
         }
         for (i, s) in parsed.services.iter().enumerate() {
             let name = s.name();
-            if name.is_empty() || !name.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'-' || b == b'_') {
+            if !harvey_bus::is_plain_name(name) {
                 return Err(at(
                     s.name.span().start,
                     format!("key `service[{i}].name`: `{name}` is not a plain name"),
@@ -147,7 +147,7 @@ impl LaunchFile {
         for (i, s) in parsed.services.iter().enumerate() {
             let Some(host) = &s.host else { continue };
             let h = host.get_ref();
-            if h.is_empty() || !h.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_') {
+            if !harvey_bus::is_plain_name(h) {
                 return Err(at(
                     host.span().start,
                     format!(

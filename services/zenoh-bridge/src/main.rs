@@ -104,8 +104,10 @@ fn exported(args: &Args) -> anyhow::Result<Vec<String>> {
 
 /// A name that goes into a key expression: letters, digits, `-` and `_`.
 fn check_name(flag: &str, name: &str) -> anyhow::Result<()> {
-    let ok = !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_');
-    anyhow::ensure!(ok, "{flag} `{name}`: use letters, digits, `-` and `_` only");
+    anyhow::ensure!(
+        harvey_bus::is_plain_name(name),
+        "{flag} `{name}`: use letters, digits, `-` and `_` only"
+    );
     Ok(())
 }
 

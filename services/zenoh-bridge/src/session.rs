@@ -11,26 +11,14 @@ pub struct Endpoints {
     pub connect: Vec<String>,
 }
 
-/// A Zenoh locator Harvey accepts: `tcp/HOST:PORT` (the only transport this build carries).
-pub fn check_endpoint(flag: &str, endpoint: &str) -> anyhow::Result<()> {
-    let Some(addr) = endpoint.strip_prefix("tcp/") else {
-        anyhow::bail!("{flag} {endpoint}: not `tcp/HOST:PORT` (this build speaks Zenoh over TCP only)");
-    };
-    let addr = addr.split('#').next().unwrap_or(addr);
-    let port_ok =
-        addr.rsplit_once(':').is_some_and(|(host, port)| !host.is_empty() && port.parse::<u16>().is_ok());
-    anyhow::ensure!(port_ok, "{flag} {endpoint}: not `tcp/HOST:PORT`");
-    Ok(())
-}
-
 /// The session's configuration: peer mode, scouting off, the endpoints given, failing at once
 /// when a listening endpoint cannot be bound.
 pub fn config(ends: &Endpoints) -> anyhow::Result<Config> {
     for e in &ends.listen {
-        check_endpoint("--zenoh-listen", e)?;
+        harvey_runtime::endpoint::tcp_address("--zenoh-listen", e)?;
     }
     for e in &ends.connect {
-        check_endpoint("--zenoh-connect", e)?;
+        harvey_runtime::endpoint::tcp_address("--zenoh-connect", e)?;
     }
     let mut c = Config::default();
     let json = |v: &[String]| {
@@ -77,15 +65,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn endpoints_are_tcp_host_port() {
-        assert!(check_endpoint("--zenoh-listen", "tcp/127.0.0.1:7447").is_ok());
-        assert!(check_endpoint("--zenoh-listen", "tcp/[::1]:7447").is_ok());
-        let e = check_endpoint("--zenoh-listen", "udp/127.0.0.1:7447").expect_err("udp").to_string();
-        assert!(e.contains("--zenoh-listen udp/127.0.0.1:7447") && e.contains("TCP only"), "{e}");
-        assert!(check_endpoint("--zenoh-connect", "tcp/127.0.0.1").is_err());
-        assert!(check_endpoint("--zenoh-connect", "tcp/:7447").is_err());
+    fn endpoints_are_checked_before_the_session_opens() {
         let e = open(&Endpoints::default()).expect_err("nothing").to_string();
         assert!(e.contains("no Zenoh endpoint"), "{e}");
+        let udp = Endpoints { listen: vec!["udp/127.0.0.1:7447".into()], connect: vec![] };
+        let e = open(&udp).expect_err("udp").to_string();
+        assert!(e.contains("--zenoh-listen udp/127.0.0.1:7447") && e.contains("TCP only"), "{e}");
     }
 
     #[test]
