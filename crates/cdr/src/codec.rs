@@ -85,11 +85,13 @@ impl<'a> CdrReader<'a> {
     }
 
     fn take(&mut self, n: usize) -> Result<&'a [u8], CdrError> {
-        let end = self.pos + n;
-        let s = self
-            .data
-            .get(self.pos..end)
-            .ok_or(CdrError::Truncated { at: self.pos, needed: end - self.data.len() })?;
+        let end = self.pos.saturating_add(n);
+        // The shortfall is worked out only when there is one (eagerly, it underflowed in debug
+        // builds on every read that succeeded).
+        let s = self.data.get(self.pos..end).ok_or_else(|| CdrError::Truncated {
+            at: self.pos,
+            needed: end.saturating_sub(self.data.len()),
+        })?;
         self.pos = end;
         Ok(s)
     }

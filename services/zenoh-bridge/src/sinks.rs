@@ -123,7 +123,8 @@ impl Sink for FrameSink {
             header.width_px,
             header.height_px
         );
-        copy_pieces(pieces, at, into);
+        let copied = copy_pieces(pieces, at, into);
+        debug_assert_eq!(copied, len, "the pieces were checked to hold the pixels");
         loan.send()?;
         Ok(())
     }
