@@ -53,13 +53,52 @@ pub fn feature_points(l: &Landmark, near: Pt, reach_m: f64) -> Vec<[f64; 3]> {
     }
 }
 
-/// Headings to try from `p` for `target`: the wedge's limits, and the heading facing the
-/// target when the wedge holds it (where its depth, and so its image row, peaks). Between them a
-/// point's image position moves monotonically, so these bound it over the whole wedge.
-fn headings(map: &Map, p: Pt, target: [f64; 3]) -> ([f64; 3], usize) {
-    let [lo, hi] = map.wedge();
-    let facing = map.heading_rad + wrap((target[1] - p[1]).atan2(target[0] - p[0]) - map.heading_rad);
-    ([lo, hi, facing], if (lo..=hi).contains(&facing) { 3 } else { 2 })
+/// The map's heading wedge, with what [`Wedge::facing`] needs worked out once per window.
+struct Wedge {
+    lo: f64,
+    hi: f64,
+    heading: [f64; 2],
+    tan_cw: f64,
+    tan_ccw: f64,
+    /// Both sides under 80 degrees: the cheap test applies.
+    narrow: bool,
+}
+
+impl Wedge {
+    fn new(map: &Map) -> Self {
+        let [lo, hi] = map.wedge();
+        let side = 0.0..1.4;
+        Self {
+            lo,
+            hi,
+            heading: [map.heading_rad.cos(), map.heading_rad.sin()],
+            tan_cw: map.cw_rad.tan(),
+            tan_ccw: map.ccw_rad.tan(),
+            narrow: side.contains(&map.cw_rad) && side.contains(&map.ccw_rad),
+        }
+    }
+
+    /// The heading facing `target` from `p`, when the wedge holds it: there the target's depth,
+    /// and so its image row, peaks. Between it and the wedge's limits a point's image position
+    /// moves monotonically, so these headings bound it over the whole wedge. A narrow wedge
+    /// first rules out, without an `atan2`, a target clearly outside it (by a millionth of its
+    /// distance, far beyond rounding); what is not ruled out gets the exact heading.
+    fn facing(&self, map: &Map, p: Pt, target: [f64; 3]) -> Option<f64> {
+        let (dx, dy) = (target[0] - p[0], target[1] - p[1]);
+        if self.narrow {
+            let [c, s] = self.heading;
+            let (along, across) = (dx * c + dy * s, dy * c - dx * s);
+            let slack = 1e-6 * (dx.abs() + dy.abs());
+            if along < -slack
+                || across > along * self.tan_ccw + slack
+                || across < -along * self.tan_cw - slack
+            {
+                return None;
+            }
+        }
+        let facing = map.heading_rad + wrap(dy.atan2(dx) - map.heading_rad);
+        (self.lo..=self.hi).contains(&facing).then_some(facing)
+    }
 }
 
 /// The Expecter's window for landmark `l` under `map`: the bounding box of its feature points
@@ -68,15 +107,26 @@ fn headings(map: &Map, p: Pt, target: [f64; 3]) -> ([f64; 3], usize) {
 pub fn window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option<Window> {
     let points = feature_points(l, map.centre, l.activation_range_m);
     let m = view.camera.calibration(view.width_px, view.height_px);
+    // The wedge's limits are the same for every vertex and point: their sines once.
+    let wedge = Wedge::new(map);
+    let limits = [wedge.lo, wedge.hi].map(|th| {
+        let (s, c) = th.sin_cos();
+        [c, s]
+    });
     let mut b = [f64::INFINITY, f64::INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY];
+    let mut grow = |p: &Pt, [c, s]: [f64; 2], x: [f64; 3]| {
+        if let Some([u, v]) = project_with(&m, [p[0], p[1], c, s], x) {
+            b = [b[0].min(u), b[1].min(v), b[2].max(u), b[3].max(v)];
+        }
+    };
     for p in &map.polygon {
         for x in &points {
-            let (hs, n) = headings(map, *p, *x);
-            for th in &hs[..n] {
+            for limit in limits {
+                grow(p, limit, *x);
+            }
+            if let Some(th) = wedge.facing(map, *p, *x) {
                 let (s, c) = th.sin_cos();
-                if let Some([u, v]) = project_with(&m, [p[0], p[1], c, s], *x) {
-                    b = [b[0].min(u), b[1].min(v), b[2].max(u), b[3].max(v)];
-                }
+                grow(p, [c, s], *x);
             }
         }
     }
@@ -154,5 +204,37 @@ mod tests {
         assert!(ahead.u0 <= now.u0 && ahead.u1 >= now.u1 && ahead.v0 <= now.v0 && ahead.v1 >= now.v1);
         // Standing still: the same window.
         assert_eq!(window_ahead(&map, view, l, 4.0, (0.0, 0.0)), Some(now));
+    }
+
+    #[test]
+    fn the_quick_wedge_test_agrees_with_the_exact_heading_everywhere() {
+        // Targets all round a vertex, some on and just beside the wedge's limits, for narrow
+        // wedges (the quick test) and wide ones (exact only), headings all round the turn.
+        let exact = |map: &Map, p: Pt, t: [f64; 3]| {
+            let [lo, hi] = map.wedge();
+            let facing = map.heading_rad + wrap((t[1] - p[1]).atan2(t[0] - p[0]) - map.heading_rad);
+            (lo..=hi).contains(&facing).then_some(facing)
+        };
+        let mut inside = 0;
+        for heading in (-8..=8).map(|k| f64::from(k) * 0.4) {
+            for (cw, ccw) in [(0.0, 0.0), (0.02, 0.05), (0.3, 0.1), (1.2, 1.3), (1.5, 0.2), (2.0, 2.5)] {
+                let map = Map { cw_rad: cw, ccw_rad: ccw, ..Map::exact(1.0, -2.0, heading) };
+                let wedge = Wedge::new(&map);
+                let p = [1.5, -1.0];
+                let limits = [heading - cw, heading + ccw];
+                let offsets = (-40..=40)
+                    .map(|k| f64::from(k) * 0.05)
+                    .chain(limits.iter().flat_map(|l| [-1e-9, 0.0, 1e-9].map(|d| l - heading + d)));
+                for a in offsets {
+                    for r in [0.3, 4.0, 25.0] {
+                        let t = [p[0] + r * (heading + a).cos(), p[1] + r * (heading + a).sin(), 1.0];
+                        let (quick, sure) = (wedge.facing(&map, p, t), exact(&map, p, t));
+                        assert_eq!(quick, sure, "heading {heading} wedge -{cw}/+{ccw} at {a} x {r} m");
+                        inside += usize::from(sure.is_some());
+                    }
+                }
+            }
+        }
+        assert!(inside > 500, "the grid reaches inside the wedges: {inside}");
     }
 }
