@@ -11,7 +11,7 @@
 //! Regions are built from runs of equal bucket along rows joined by union-find, and their
 //! moments come from closed forms over each run, so the work is per run, not per pixel.
 
-use crate::flf_pass::{self, G, Pass, SIDE};
+use crate::flf_pass::{self, Buckets, Pass, SIDE};
 use crate::image::{Gray, Rect, VisionError};
 use crate::regions::{Moments, Runs, cell_gradient};
 use crate::simd::Path;
@@ -65,7 +65,7 @@ pub use crate::regions::Line;
 #[derive(Debug, Default)]
 pub struct Flf {
     lut: Vec<u8>,
-    lut_key: Option<(u8, u32, bool, u32)>,
+    lut_key: Option<(u8, u32, bool)>,
     labels: Vec<u8>,
     gradients: Vec<i16>,
     runs: [Runs; 2],
@@ -168,30 +168,19 @@ impl Flf {
         Ok(&self.lines)
     }
 
-    /// Bucket of every gradient (or 0 when too weak), both partitions in one byte.
+    /// Readies the table of every gradient's bucket byte (both partitions in one byte) for
+    /// `p`'s buckets: emptied when they change, filled by the gradient pass as it meets each
+    /// gradient. The pass looks it up for strong cells only, so it does not depend on the
+    /// strength floor (which follows the image's noise from frame to frame), and only the
+    /// gradients a camera produces cost an `atan2` (a whole table is 261 121 of them).
     fn build_lut(&mut self, p: &FlfParams) {
-        let key = (p.buckets, p.offset_deg.to_bits(), p.overlap, p.min_gradient.to_bits());
+        let key = (p.buckets, p.offset_deg.to_bits(), p.overlap);
         if self.lut_key == Some(key) {
             return;
         }
         self.lut_key = Some(key);
         self.lut.clear();
-        self.lut.resize(SIDE * SIDE, 0);
-        let width = 360.0 / f32::from(p.buckets);
-        let min2 = p.min_gradient * p.min_gradient;
-        for gy in -G..=G {
-            for gx in -G..=G {
-                let (fx, fy) = (gx as f32, gy as f32);
-                if fx * fx + fy * fy < min2.max(1.0) {
-                    continue;
-                }
-                let dir = fy.atan2(fx).to_degrees();
-                let bucket = |offset: f32| ((dir - offset).rem_euclid(360.0) / width) as u8 % p.buckets + 1;
-                let a = bucket(p.offset_deg);
-                let b = if p.overlap { bucket(p.offset_deg + width / 2.0) } else { 0 };
-                self.lut[((gy + G) as usize) * SIDE + (gx + G) as usize] = a | (b << 4);
-            }
-        }
+        self.lut.resize(SIDE * SIDE, flf_pass::UNSEEN);
     }
 
     /// The bucket byte of each 2x2 cell of the window: `(width - 1) x (height - 1)`.
@@ -203,8 +192,9 @@ impl Flf {
         self.gradients.resize(2 * ww, 0);
         let strong = (p.min_gradient * p.min_gradient).max(1.0).ceil() as i32;
         let path = self.path();
-        let pass =
-            Pass { img, window: w, strong, lut: &self.lut, labels: &mut self.labels, g: &mut self.gradients };
+        let buckets = Buckets { count: p.buckets, offset_deg: p.offset_deg, overlap: p.overlap };
+        let (lut, labels, g) = (&mut self.lut, &mut self.labels, &mut self.gradients);
+        let pass = Pass { img, window: w, strong, buckets, lut, labels, g };
         flf_pass::label(path, pass);
     }
 }
@@ -294,5 +284,39 @@ mod tests {
         assert!(f.lines(&faint.view(), faint.view().full(), &FlfParams::default()).expect("runs").is_empty());
         let bad = FlfParams { buckets: 1, ..FlfParams::default() };
         assert!(matches!(f.lines(&img.view(), img.view().full(), &bad), Err(VisionError::BadParameter(_))));
+    }
+
+    #[test]
+    fn a_finder_reused_over_floors_and_buckets_finds_what_a_fresh_one_does() {
+        // The orientation table is filled as gradients come and kept while the buckets stay:
+        // a finder that has seen other floors and buckets must find exactly the same lines.
+        let disc = shape(160, 120, |x, y| (x - 80.0).hypot(y - 60.0) < 40.0);
+        let square = shape(160, 120, |x, y| (x - y).abs() < 30.0 && x + y > 60.0 && x + y < 220.0);
+        let p = |buckets, offset_deg, min_gradient, overlap| FlfParams {
+            buckets,
+            offset_deg,
+            min_gradient,
+            overlap,
+            noise_factor: 0.0,
+            min_length: 4.0,
+            ..FlfParams::default()
+        };
+        let runs = [
+            (&disc, p(8, 0.0, 8.0, true)),
+            (&square, p(8, 0.0, 20.0, true)),
+            (&disc, p(8, 0.0, 2.0, true)),
+            (&square, p(6, 10.0, 8.0, false)),
+            (&disc, p(15, 3.0, 1.0, true)),
+            (&disc, p(8, 0.0, 8.0, true)),
+        ];
+        let mut reused = Flf::default();
+        let mut total = 0;
+        for (img, p) in runs {
+            let (g, full) = (img.view(), img.view().full());
+            let again = reused.lines(&g, full, &p).expect("runs").to_vec();
+            assert_eq!(again, Flf::default().lines(&g, full, &p).expect("runs"), "{p:?}");
+            total += again.len();
+        }
+        assert!(total > 20, "the images give lines: {total}");
     }
 }

@@ -11,13 +11,44 @@ pub(crate) const G: i32 = 255;
 /// The side of the look-up table, indexed by `(gy + G) * SIDE + gx + G`.
 pub(crate) const SIDE: usize = (2 * G + 1) as usize;
 
+/// A look-up table entry not worked out yet (a bucket byte is never 0: buckets count from 1).
+pub(crate) const UNSEEN: u8 = 0;
+
+/// The orientation buckets a gradient is sorted into.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Buckets {
+    /// How many over 360 degrees (2 to 15).
+    pub count: u8,
+    /// Where the first starts.
+    pub offset_deg: f32,
+    /// A second partition shifted by half a bucket, in the byte's high nibble.
+    pub overlap: bool,
+}
+
+impl Buckets {
+    /// The bucket byte of gradient `(gx, gy)`, not both 0: the bucket from 1 in the low nibble,
+    /// the shifted partition's in the high one (0 without overlap).
+    #[cold]
+    fn byte(self, gx: i32, gy: i32) -> u8 {
+        let width = 360.0 / f32::from(self.count);
+        let dir = (gy as f32).atan2(gx as f32).to_degrees();
+        let bucket = |offset: f32| ((dir - offset).rem_euclid(360.0) / width) as u8 % self.count + 1;
+        let a = bucket(self.offset_deg);
+        let b = if self.overlap { bucket(self.offset_deg + width / 2.0) } else { 0 };
+        a | (b << 4)
+    }
+}
+
 /// One window's pass: `labels` gets `(width - 1) x (height - 1)` bucket bytes (0: weak), a
-/// cell strong where `gx² + gy² >= strong`; `g` is scratch of `2 (width - 1)`.
+/// cell strong where `gx² + gy² >= strong` (at least 1); `lut` is the `SIDE x SIDE` table of
+/// bucket bytes, [`UNSEEN`] where not worked out yet (the pass fills in what it meets); `g` is
+/// scratch of `2 (width - 1)`.
 pub(crate) struct Pass<'a, 'b> {
     pub img: &'a Gray<'b>,
     pub window: Rect,
     pub strong: i32,
-    pub lut: &'a [u8],
+    pub buckets: Buckets,
+    pub lut: &'a mut [u8],
     pub labels: &'a mut [u8],
     pub g: &'a mut [i16],
 }
@@ -38,7 +69,7 @@ pub(crate) fn label(path: Path, p: Pass<'_, '_>) {
 /// The one body.
 #[inline(always)]
 fn label_rows(p: Pass<'_, '_>) {
-    let (w, lut) = (p.window, p.lut);
+    let (w, lut, buckets) = (p.window, p.lut, p.buckets);
     let (ww, wh) = (w.width() - 1, w.height() - 1);
     let (gxs, gys) = p.g.split_at_mut(ww);
     for y in 0..wh {
@@ -62,7 +93,11 @@ fn label_rows(p: Pass<'_, '_>) {
             }
             if out[x] != 0 {
                 let (gx, gy) = (i32::from(gxs[x]), i32::from(gys[x]));
-                out[x] = lut[((gy + G) as usize) * SIDE + (gx + G) as usize];
+                let entry = &mut lut[((gy + G) as usize) * SIDE + (gx + G) as usize];
+                if *entry == UNSEEN {
+                    *entry = buckets.byte(gx, gy);
+                }
+                out[x] = *entry;
             }
             x += 1;
         }
