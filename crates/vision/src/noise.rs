@@ -4,14 +4,22 @@
 //! per pixel, with the 2x2 cell's halved sums), so thresholds can sit a few sigma above it
 //! whatever the camera (dim, noisy, vignetted) instead of at a fixed grey level.
 
+use std::sync::OnceLock;
+
 use crate::image::{Gray, Rect};
-use crate::regions::cell_gradient;
 
 /// Median of a Rayleigh magnitude, in units of the per-component sigma: sqrt(2 ln 2).
 const RAYLEIGH_MEDIAN: f32 = 1.177_410_1;
 
 /// Every how many cells, across and down, one is sampled.
 const STRIDE: usize = 3;
+
+/// Histogram bins: gradient magnitudes to a quarter grey level, the last taking all above.
+const BINS: usize = 1024;
+
+/// Cells whose doubled gradient components square-sum below this (a magnitude under 32 grey
+/// levels: all of the noise, most of a scene) take their bin from a table, not a square root.
+const TABLED: usize = 4096;
 
 /// The per-pixel noise sigma (grey levels) of `w` in `img`, estimated from the median cell
 /// gradient; 0 for a window too small to sample (under 2x2 pixels).
@@ -21,12 +29,16 @@ pub fn noise_sigma(img: &Gray<'_>, w: Rect) -> f32 {
     }
     // Gradient magnitudes to a quarter grey level, capped: the median of a noisy scene sits far
     // below the cap.
-    let mut histogram = [0u32; 1024];
+    let mut histogram = [0u32; BINS];
+    let table = table();
     let mut n = 0u32;
     for y in (w.y0..w.y1 - 1).step_by(STRIDE) {
-        for x in (w.x0..w.x1 - 1).step_by(STRIDE) {
-            let g = cell_gradient(img, x, y);
-            histogram[((g * 4.0) as usize).min(histogram.len() - 1)] += 1;
+        let (r0, r1) = (&img.row(y)[w.x0..w.x1], &img.row(y + 1)[w.x0..w.x1]);
+        for x in (0..w.width() - 1).step_by(STRIDE) {
+            let [a, b, c, d] = [r0[x], r0[x + 1], r1[x], r1[x + 1]].map(i32::from);
+            let (gx2, gy2) = (b + d - a - c, c + d - a - b);
+            let s = (gx2 * gx2 + gy2 * gy2) as usize;
+            histogram[table.get(s).map_or_else(|| bin(s), |&b| usize::from(b))] += 1;
             n += 1;
         }
     }
@@ -38,6 +50,20 @@ pub fn noise_sigma(img: &Gray<'_>, w: Rect) -> f32 {
         }
     }
     0.0
+}
+
+/// The histogram bin of a 2x2 cell whose gradient components, doubled (`b + d - a - c` and
+/// `c + d - a - b`), square-sum to `s`: `regions::cell_gradient`'s magnitude `sqrt(s / 4)`, in
+/// the same `f32` arithmetic (`s / 4` is exact there), times 4, truncated, capped.
+fn bin(s: usize) -> usize {
+    let quarters = ((s as f32) * 0.25).sqrt() * 4.0;
+    (quarters as usize).min(BINS - 1)
+}
+
+/// [`bin`] for every `s` under [`TABLED`], worked out once.
+fn table() -> &'static [u16; TABLED] {
+    static TABLE: OnceLock<[u16; TABLED]> = OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|s| bin(s) as u16))
 }
 
 #[cfg(test)]
@@ -76,5 +102,24 @@ mod tests {
         }
         let img = noisy(3.0, 1);
         assert_eq!(noise_sigma(&img.view(), Rect::new(5, 5, 6, 6)), 0.0, "a single pixel");
+    }
+
+    #[test]
+    fn every_cell_gets_the_bin_of_its_gradient_magnitude() {
+        // All the doubled components a 2x2 cell of bytes can have, against the magnitude the
+        // line finder's regions use, to a quarter grey level: the table and the square root
+        // agree with it everywhere.
+        let table = table();
+        for gx2 in -510i32..=510 {
+            for gy2 in -510i32..=510 {
+                let (gx, gy) = (gx2 as f32 / 2.0, gy2 as f32 / 2.0);
+                let want = (((gx * gx + gy * gy).sqrt() * 4.0) as usize).min(BINS - 1);
+                let s = (gx2 * gx2 + gy2 * gy2) as usize;
+                assert_eq!(bin(s), want, "({gx2}, {gy2})");
+                if let Some(&b) = table.get(s) {
+                    assert_eq!(usize::from(b), want, "({gx2}, {gy2}) tabled");
+                }
+            }
+        }
     }
 }
