@@ -15,6 +15,8 @@ pub struct Profile {
     n: usize,
     /// Per band, each column's mean level relative to the band's first column (`bands * n`).
     levels: Vec<f32>,
+    /// The levels' sums over each band's rows (scratch).
+    sums: Vec<i32>,
     /// Per column `k`, the step from `k` to `k + span`: its magnitude averaged over the bands.
     pub strength: Vec<f32>,
 }
@@ -34,24 +36,33 @@ impl Profile {
         let rows = v1 - v0;
         self.n = u1 - u0;
         self.bands = (rows / band_rows.max(1)).max(1);
-        self.levels.clear();
-        self.levels.resize(self.bands * self.n, 0.0);
+        // Summed as integers (mono8 rows vectorise): the values an f32 sum takes, exact while
+        // a band's sums stay under 2^24 (255 x 65 793 rows).
+        self.sums.clear();
+        self.sums.resize(self.bands * self.n, 0);
         let mut brightness = 0u64;
         for (r, row) in pixels.chunks_exact(stride).skip(v0).take(rows).enumerate() {
             let band = r * self.bands / rows;
-            let levels = &mut self.levels[band * self.n..(band + 1) * self.n];
-            let first = f32::from(row[u0 * bpp]);
-            for (k, level) in levels.iter_mut().enumerate() {
-                let p = row[(u0 + k) * bpp];
-                *level += f32::from(p) - first;
-                brightness += u64::from(p);
+            let sums = &mut self.sums[band * self.n..(band + 1) * self.n];
+            let first = i32::from(row[u0 * bpp]);
+            if bpp == 1 {
+                for (sum, &p) in sums.iter_mut().zip(&row[u0..u0 + self.n]) {
+                    *sum += i32::from(p) - first;
+                    brightness += u64::from(p);
+                }
+            } else {
+                for (k, sum) in sums.iter_mut().enumerate() {
+                    let p = row[(u0 + k) * bpp];
+                    *sum += i32::from(p) - first;
+                    brightness += u64::from(p);
+                }
             }
         }
+        self.levels.clear();
         for band in 0..self.bands {
             let band_rows = ((band + 1) * rows / self.bands - band * rows / self.bands) as f32;
-            for level in &mut self.levels[band * self.n..(band + 1) * self.n] {
-                *level /= band_rows;
-            }
+            let sums = &self.sums[band * self.n..(band + 1) * self.n];
+            self.levels.extend(sums.iter().map(|&sum| sum as f32 / band_rows));
         }
         (brightness as f32 / (rows * self.n) as f32, rows as f32 / self.bands as f32)
     }
@@ -174,5 +185,19 @@ mod tests {
         assert!(p.is_step(5, 3));
         assert!(!p.is_step(1, 3) && !p.is_step(12, 3), "too near the window's side for a plateau");
         assert_eq!(p.edge_at(5, 3), 6.0, "the middle step of the ramp: between columns 6 and 7");
+    }
+
+    #[test]
+    fn an_rgb_window_gives_what_its_first_channel_as_mono_gives() {
+        // A window inside a 23-column frame, away from its corner, three bands of uneven rows.
+        let grey = |i: usize| ((i % 23) * 9 + (i / 23) * 5 % 7) as u8;
+        let mono: Vec<u8> = (0..23 * 20).map(grey).collect();
+        let rgb: Vec<u8> = (0..23 * 20).flat_map(|i| [grey(i), 255 - grey(i), 7]).collect();
+        let (mut a, mut b) = (Profile::default(), Profile::default());
+        let window = [3, 2, 21, 19];
+        assert_eq!(a.fill(&mono, 23, 1, window, 5), b.fill(&rgb, 69, 3, window, 5));
+        assert_eq!(a.levels, b.levels);
+        assert_eq!(a.levels.len(), 3 * 18);
+        assert!(a.levels.iter().any(|&l| l != 0.0));
     }
 }
