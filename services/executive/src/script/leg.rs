@@ -5,6 +5,7 @@
 
 use harvey_msgs::Pose2;
 
+use super::sighting::{Sighted, measure_mount, sighting};
 use crate::servo::{ServoParams, correction, correction_off_line, heading_error, heading_error_off_line};
 
 /// How a leg estimates its offset from the intended line.
@@ -174,34 +175,18 @@ impl Leg {
             self.done = 1;
             return LegStep::Move(self.increment(0));
         }
-        let (Some(s), Some([u, v])) = (self.servo, seen) else {
+        let (Some(s), Some(uv)) = (self.servo, seen) else {
             self.misses += u32::from(seen.is_none());
             return self.next_move();
         };
         // The landmark in the frame of the intended line at the expected position.
         let e = self.expected(self.done);
-        let (c, sn) = (e.heading_rad.cos(), e.heading_rad.sin());
-        let (dx, dy) = (s.point[0] - e.x_m, s.point[1] - e.y_m);
-        let mut landmark = [dx * c + dy * sn, -dx * sn + dy * c];
-        // Its distance from the row it is seen in, where it stands well above or below the camera.
-        let (dz, rise) = (s.point[2] - s.camera_height_m, f64::from(s.height_px) / 2.0 - v);
-        // The row as a level camera would have seen it.
-        let rise = s.params.focal_px * ((rise / s.params.focal_px).atan() - self.mount_rad.1).tan();
-        let params = ServoParams { misalignment_rad: self.mount_rad.0, ..s.params };
-        let x_left = f64::from(s.width_px) / 2.0 - u;
-        let bearing_error =
-            landmark[1].atan2(landmark[0]) - ((x_left / params.focal_px).atan() + params.misalignment_rad);
-        if bearing_error.abs() > s.gate_rad + self.offset_m.abs() / landmark[0].max(1.0) {
-            return self.false_match(bearing_error, None);
-        }
-        if dz.abs() > 0.2 && rise * dz > 0.0 && rise.abs() > 2.0 {
-            let measured = dz * params.focal_px / rise;
-            if (measured - landmark[0]).abs() > s.gate_range * landmark[0] {
-                return self.false_match(bearing_error, Some(measured - landmark[0]));
-            }
-            self.shortfall_m -= landmark[0] - measured;
-            landmark[0] = measured;
-        }
+        let sighted = match sighting(&s, e, self.mount_rad, self.offset_m, uv) {
+            Ok(sighted) => sighted,
+            Err((bearing_error, range_error_m)) => return self.false_match(bearing_error, range_error_m),
+        };
+        let Sighted { landmark, x_left, params, range_error_m } = sighted;
+        self.shortfall_m += range_error_m.unwrap_or(0.0);
         let m = self.increment(self.done - 1);
         let (h, turn) = match self.tracking {
             // 000 §5.5 as written: the increment started on the line.
@@ -250,20 +235,6 @@ impl Leg {
         self.done += 1;
         LegStep::Move(self.increment(self.done - 1))
     }
-}
-
-/// The mount's (yaw, pitch) from the landmark seen at image `[u, v]` by a robot standing at
-/// `at` on the line, heading along it: the difference between where the point should appear to a
-/// true camera and where it does.
-fn measure_mount(s: &ServoSetup, at: Pose2, [u, v]: [f64; 2]) -> (f64, f64) {
-    let f = s.params.focal_px;
-    let (c, sn) = (at.heading_rad.cos(), at.heading_rad.sin());
-    let (dx, dy) = (s.point[0] - at.x_m, s.point[1] - at.y_m);
-    let (ahead, left) = (dx * c + dy * sn, -dx * sn + dy * c);
-    let (x_left, rise) = (f64::from(s.width_px) / 2.0 - u, f64::from(s.height_px) / 2.0 - v);
-    let yaw = left.atan2(ahead) - (x_left / f).atan();
-    let pitch = (rise / f).atan() - (s.point[2] - s.camera_height_m).atan2(ahead);
-    (yaw, pitch)
 }
 
 /// The tests' servoing set-up: a landmark 16 m down the line, 0.2 m to its left, at the

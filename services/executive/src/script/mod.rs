@@ -9,6 +9,7 @@ pub mod leg;
 pub mod recover;
 mod refining;
 mod runner;
+mod sighting;
 pub mod window;
 
 use harvey_msgs::{CommandKind, MissionState, Pose2, ServoLevel};

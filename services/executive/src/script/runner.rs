@@ -76,12 +76,12 @@ impl Script {
                 };
                 let Some(s) = l.servo else { return Vec::new() };
                 // Tracked only where a sighting the leg would accept can be; the first look, with
-                // the mount not yet measured, discovers the landmark in the whole frame.
-                let window = (!l.discovering())
-                    .then(|| {
-                        super::window::look_window(&s, expected, l.mount_rad, l.offset_m, sv.template_px)
-                    })
-                    .flatten();
+                // the mount not yet measured, also where the mount's error can put it.
+                let window = if l.discovering() {
+                    super::window::first_look_window(&s, expected, l.mount_rad, sv.template_px)
+                } else {
+                    super::window::look_window(&s, expected, l.mount_rad, l.offset_m, sv.template_px)
+                };
                 let request = self.next_request;
                 self.next_request += 1;
                 self.phase = Phase::Looking { step, request };

@@ -13,6 +13,11 @@ use super::leg::ServoSetup;
 /// Pixels added round the gates' extent: the template's placement is found to a pixel or two.
 const MARGIN_PX: f64 = 4.0;
 
+/// How far (either way, yaw and pitch) the first look allows the camera's mount to be from
+/// its configured angles, before the look measures it: a degree, beyond the errors a mount
+/// has (000 §5.5 Fig. 10 studies 1 and 10 mrad; the harsh condition's sd is 10 mrad).
+const MOUNT_TOLERANCE_RAD: f64 = std::f64::consts::PI / 180.0;
+
 /// The window `[u0, v0, u1, v1]` (pixels) to look for `s`'s point in, from `expected`, with the
 /// mount's `(yaw, pitch)` and the leg's estimated offset from its line; `None` (the whole frame)
 /// when the point is behind the camera or the window would not hold the template.
@@ -49,6 +54,25 @@ pub fn look_window(
     ];
     let holds = |lo: f64, hi: f64| hi - lo > 2.0 * half_template + 1.0;
     (holds(window[0], window[2]) && holds(window[1], window[3])).then(|| window.map(|x| x.round() as f32))
+}
+
+/// The first look's window, before the mount is measured, from the leg's start, where the
+/// robot stands on its line heading along it (no motion to gate yet): where the point appears
+/// for every mount within [`MOUNT_TOLERANCE_RAD`] of `mount_rad` (the union of the two extreme
+/// mounts' windows: the columns move with the yaw, the rows with the pitch, each one way). A
+/// search of the whole frame can lock on another surface's better match (the hall's corner
+/// beside the exit sign under harsh light), and the mount measured from it sends every later
+/// look astray.
+pub fn first_look_window(
+    s: &ServoSetup,
+    expected: Pose2,
+    mount_rad: (f64, f64),
+    template_px: u32,
+) -> Option<[f32; 4]> {
+    let (t, still) = (MOUNT_TOLERANCE_RAD, ServoSetup { gate_rad: 0.0, gate_range: 0.0, ..*s });
+    let low = look_window(&still, expected, (mount_rad.0 - t, mount_rad.1 - t), 0.0, template_px)?;
+    let high = look_window(&still, expected, (mount_rad.0 + t, mount_rad.1 + t), 0.0, template_px)?;
+    Some([low[0].min(high[0]), low[1].min(high[1]), low[2].max(high[2]), low[3].max(high[3])])
 }
 
 #[cfg(test)]
@@ -103,5 +127,32 @@ mod tests {
         // Facing 60 degrees off, the predicted column is off the image: nothing fits the template.
         let askew = Pose2 { heading_rad: 60f64.to_radians(), ..Pose2::default() };
         assert_eq!(look_window(&s, askew, (0.0, 0.0), 0.0, 16), None);
+    }
+
+    #[test]
+    fn the_first_look_covers_any_mount_within_a_degree_and_no_more() {
+        let s = sign();
+        let first = first_look_window(&s, Pose2::default(), (0.0, 0.0), 16).expect("in view");
+        // Where the point appears for a mount (yaw left, pitch down), seen from the start.
+        let seen = |(yaw, pitch): (f64, f64)| {
+            let u = 320.0 - 554.0 * ((0.2f64 / 12.0).atan() - yaw).tan();
+            let v = 240.0 - 554.0 * ((1.0f64 / 12.0).atan() + pitch).tan();
+            (u, v)
+        };
+        let holds = |(u, v): (f64, f64)| {
+            (f64::from(first[0])..=f64::from(first[2])).contains(&u)
+                && (f64::from(first[1])..=f64::from(first[3])).contains(&v)
+        };
+        // Every mount within the tolerance (a harsh day's 5 mrad left and 12 mrad up included)
+        // puts the point inside it, with room for the template's half (8 px) beyond.
+        for mount in [(0.0, 0.0), (0.0175, 0.0175), (-0.0175, -0.0175), (0.0175, -0.0175), (0.0045, -0.012)] {
+            let (u, v) = seen(mount);
+            assert!(holds((u - 8.0, v - 8.0)) && holds((u + 8.0, v + 8.0)), "{mount:?}: {u} {v} {first:?}");
+        }
+        // Three degrees of yaw (the tracking gate's) or of pitch is outside, and so is the side
+        // wall's corner 1.2 m right of the sign.
+        assert!(!holds(seen((0.052, 0.0))) && !holds(seen((-0.052, 0.0))) && !holds(seen((0.0, 0.052))));
+        let corner = 320.0 - 554.0 * ((0.2f64 - 1.2) / 12.0).atan().tan();
+        assert!(corner > f64::from(first[2]), "{corner} in {first:?}");
     }
 }
