@@ -103,7 +103,10 @@ fn servoing_holds_the_line_for_40_ft_where_open_loop_wanders_off_it() {
 #[test]
 fn over_seeds_servoing_holds_the_line_within_its_budget() {
     for condition in ["ideal", "nominal", "harsh"] {
-        for seed in 1..=3 {
+        // Harsh seed 13 too: searched over the whole frame, its first look took the hall's
+        // corner for the exit sign's, measured the mount 127 px off, and the run failed.
+        let extra = (condition == "harsh").then_some(13);
+        for seed in (1..=3).chain(extra) {
             let out = common::run_mission_under("missions/hallway-40ft.toml", condition, seed, "h40s");
             let Run { truth, looks, .. } = decode(out, "missions/hallway-40ft.toml", "1/1");
             let held = worst(&truth, 0.0, 40.0) / INCH;
