@@ -21,10 +21,12 @@ const BINS: usize = 1024;
 /// levels: all of the noise, most of a scene) take their bin from a table, not a square root.
 const TABLED: usize = 4096;
 
-/// The per-pixel noise sigma (grey levels) of `w` in `img`, estimated from the median cell
-/// gradient; 0 for a window too small to sample (under 2x2 pixels).
+/// The per-pixel noise sigma (grey levels) of `w` in `img` (the part inside the image),
+/// estimated from the median cell gradient; 0 for a window too small to sample (under 2x2
+/// pixels).
 pub fn noise_sigma(img: &Gray<'_>, w: Rect) -> f32 {
-    if w.width() < 2 || w.height() < 2 {
+    let w = Rect::new(w.x0, w.y0, w.x1.min(img.width), w.y1.min(img.height));
+    if w.x1 < w.x0 + 2 || w.y1 < w.y0 + 2 {
         return 0.0;
     }
     // Gradient magnitudes to a quarter grey level, capped: the median of a noisy scene sits far
@@ -102,6 +104,10 @@ mod tests {
         }
         let img = noisy(3.0, 1);
         assert_eq!(noise_sigma(&img.view(), Rect::new(5, 5, 6, 6)), 0.0, "a single pixel");
+        // A window reaching past the image: its part inside, no panic.
+        let (g, inside) = (img.view(), Rect::new(100, 60, 160, 120));
+        assert_eq!(noise_sigma(&g, Rect::new(100, 60, 500, 400)), noise_sigma(&g, inside));
+        assert_eq!(noise_sigma(&g, Rect::new(159, 10, 300, 20)), 0.0, "one column inside");
     }
 
     #[test]

@@ -100,6 +100,7 @@ impl LineLandmarks {
         let (w, ht, stride) = (h.width_px as usize, h.height_px as usize, h.stride_bytes as usize);
         if e.class != 1
             || (e.width_px, e.height_px) != (h.width_px, h.height_px)
+            || stride < w * bpp
             || pixels.len() < stride * ht
         {
             return None;
@@ -226,6 +227,19 @@ mod tests {
         assert_eq!(s.kind, SightingKind::Bearing as u32);
         let other_size = Expectation { width_px: 640, ..expect(30.0, 50.0) };
         assert!(r.recognise(&h, &frame(&[]), &other_size).is_none());
+    }
+
+    #[test]
+    fn a_frame_whose_rows_do_not_fit_its_stride_is_no_answer_not_a_panic() {
+        let mut r = LineLandmarks::new(55.4, 10.0);
+        let f = frame(&[(40, 200)]);
+        for stride in [0, 1, 63] {
+            let h = FrameHeader { stride_bytes: stride, ..FrameHeader::new(1, 0, 64, 48, Encoding::Mono8) };
+            assert!(r.recognise(&h, &f, &expect(30.0, 50.0)).is_none(), "stride {stride}");
+        }
+        // An rgb8 header over mono bytes: three bytes a pixel do not fit a 64-byte row.
+        let rgb = FrameHeader { stride_bytes: 64, ..FrameHeader::new(1, 0, 64, 48, Encoding::Rgb8) };
+        assert!(r.recognise(&rgb, &f, &expect(30.0, 50.0)).is_none());
     }
 
     /// `frame` with seeded noise of deviation `sd` added.

@@ -129,8 +129,9 @@ impl Leg {
         self.line.arc(d, 0.0)
     }
 
-    /// Whether the look asked for is the first, measuring the mount: discovery over the whole
-    /// frame (002 §5.2), where later looks track the landmark in the window the gates allow.
+    /// Whether the look asked for is the first, measuring the mount: discovery (002 §5.2) where
+    /// any mount within its tolerance can put the landmark (`window::first_look_window`), where
+    /// later looks track it in the window the gates allow.
     pub fn discovering(&self) -> bool {
         self.phase == Phase::Calibrating
     }
@@ -317,7 +318,7 @@ mod tests {
         };
         let mut leg = Leg::new(Pose2::default(), 1.2, 0.6, Some(s));
         assert_eq!(leg.start(), LegStep::Look(Pose2::default()), "looks before moving");
-        assert!(leg.discovering(), "the first look, the mount unknown, searches the whole frame");
+        assert!(leg.discovering(), "the first look, the mount unknown, discovers the landmark");
         assert_eq!(leg.on_seen(Some(seen(16.0))), LegStep::Move(0.6));
         assert!(!leg.discovering());
         assert!((leg.mount_rad.0 - yaw).abs() < 1e-12 && (leg.mount_rad.1 - pitch).abs() < 1e-12);

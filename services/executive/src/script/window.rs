@@ -57,7 +57,9 @@ pub fn look_window(
 }
 
 /// The first look's window, before the mount is measured, from the leg's start, where the
-/// robot stands on its line heading along it (no motion to gate yet): where the point appears
+/// robot stands on its line heading along it (no motion to gate yet; the mount measured from
+/// this look takes that for granted too, so a start off the line or its heading is outside what
+/// the look can tell either way): where the point appears
 /// for every mount within [`MOUNT_TOLERANCE_RAD`] of `mount_rad` (the union of the two extreme
 /// mounts' windows: the columns move with the yaw, the rows with the pitch, each one way). A
 /// search of the whole frame can lock on another surface's better match (the hall's corner
@@ -70,9 +72,13 @@ pub fn first_look_window(
     template_px: u32,
 ) -> Option<[f32; 4]> {
     let (t, still) = (MOUNT_TOLERANCE_RAD, ServoSetup { gate_rad: 0.0, gate_range: 0.0, ..*s });
-    let low = look_window(&still, expected, (mount_rad.0 - t, mount_rad.1 - t), 0.0, template_px)?;
-    let high = look_window(&still, expected, (mount_rad.0 + t, mount_rad.1 + t), 0.0, template_px)?;
-    Some([low[0].min(high[0]), low[1].min(high[1]), low[2].max(high[2]), low[3].max(high[3])])
+    let low = look_window(&still, expected, (mount_rad.0 - t, mount_rad.1 - t), 0.0, template_px);
+    let high = look_window(&still, expected, (mount_rad.0 + t, mount_rad.1 + t), 0.0, template_px);
+    match (low, high) {
+        (Some(a), Some(b)) => Some([a[0].min(b[0]), a[1].min(b[1]), a[2].max(b[2]), a[3].max(b[3])]),
+        // At the image's edge one extreme's window may not hold the template: the other's.
+        (a, b) => a.or(b),
+    }
 }
 
 #[cfg(test)]
