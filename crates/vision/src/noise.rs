@@ -7,6 +7,7 @@
 use std::sync::OnceLock;
 
 use crate::image::{Gray, Rect};
+use crate::regions::{TABLED, doubled_square, magnitude};
 
 /// Median of a Rayleigh magnitude, in units of the per-component sigma: sqrt(2 ln 2).
 const RAYLEIGH_MEDIAN: f32 = 1.177_410_1;
@@ -16,10 +17,6 @@ const STRIDE: usize = 3;
 
 /// Histogram bins: gradient magnitudes to a quarter grey level, the last taking all above.
 const BINS: usize = 1024;
-
-/// Cells whose doubled gradient components square-sum below this (a magnitude under 32 grey
-/// levels: all of the noise, most of a scene) take their bin from a table, not a square root.
-const TABLED: usize = 4096;
 
 /// The per-pixel noise sigma (grey levels) of `w` in `img` (the part inside the image),
 /// estimated from the median cell gradient; 0 for a window too small to sample (under 2x2
@@ -37,9 +34,7 @@ pub fn noise_sigma(img: &Gray<'_>, w: Rect) -> f32 {
     for y in (w.y0..w.y1 - 1).step_by(STRIDE) {
         let (r0, r1) = (&img.row(y)[w.x0..w.x1], &img.row(y + 1)[w.x0..w.x1]);
         for x in (0..w.width() - 1).step_by(STRIDE) {
-            let [a, b, c, d] = [r0[x], r0[x + 1], r1[x], r1[x + 1]].map(i32::from);
-            let (gx2, gy2) = (b + d - a - c, c + d - a - b);
-            let s = (gx2 * gx2 + gy2 * gy2) as usize;
+            let s = doubled_square([r0[x], r0[x + 1], r1[x], r1[x + 1]]);
             histogram[table.get(s).map_or_else(|| bin(s), |&b| usize::from(b))] += 1;
             n += 1;
         }
@@ -54,15 +49,16 @@ pub fn noise_sigma(img: &Gray<'_>, w: Rect) -> f32 {
     0.0
 }
 
-/// The histogram bin of a 2x2 cell whose gradient components, doubled (`b + d - a - c` and
-/// `c + d - a - b`), square-sum to `s`: `regions::cell_gradient`'s magnitude `sqrt(s / 4)`, in
-/// the same `f32` arithmetic (`s / 4` is exact there), times 4, truncated, capped.
+/// The histogram bin of a 2x2 cell whose doubled gradient components square-sum to `s`
+/// (`regions::doubled_square`): its magnitude (`regions::magnitude`, the one `cell_gradient`
+/// gives) times 4, truncated, capped.
 fn bin(s: usize) -> usize {
-    let quarters = ((s as f32) * 0.25).sqrt() * 4.0;
-    (quarters as usize).min(BINS - 1)
+    ((magnitude(s) * 4.0) as usize).min(BINS - 1)
 }
 
-/// [`bin`] for every `s` under [`TABLED`], worked out once.
+/// [`bin`] for every `s` under [`TABLED`] (a magnitude under 32 grey levels: all of the noise,
+/// most of a scene), worked out once: the square root and the float-to-integer conversion were
+/// the estimate's cost.
 fn table() -> &'static [u16; TABLED] {
     static TABLE: OnceLock<[u16; TABLED]> = OnceLock::new();
     TABLE.get_or_init(|| std::array::from_fn(|s| bin(s) as u16))

@@ -242,20 +242,27 @@ impl Moments {
 #[inline]
 pub fn cell_gradient(img: &Gray<'_>, x: usize, y: usize) -> f32 {
     let (r0, r1) = (&img.row(y)[x..x + 2], &img.row(y + 1)[x..x + 2]);
-    let [a, b, c, d] = [r0[0], r0[1], r1[0], r1[1]].map(i32::from);
+    magnitude(doubled_square([r0[0], r0[1], r1[0], r1[1]]))
+}
+
+/// The square sum of a 2x2 cell's doubled gradient components (`b + d - a - c` and
+/// `c + d - a - b` for the cell `[a b; c d]`, given in that order): integers, exact.
+#[inline]
+pub(crate) fn doubled_square(cell: [u8; 4]) -> usize {
+    let [a, b, c, d] = cell.map(i32::from);
     let (gx2, gy2) = (b + d - a - c, c + d - a - b);
-    magnitude((gx2 * gx2 + gy2 * gy2) as usize)
+    (gx2 * gx2 + gy2 * gy2) as usize
 }
 
 /// Squared doubled gradients below this (a magnitude under 32 grey levels) take their
 /// magnitude from a table.
-const TABLED: usize = 4096;
+pub(crate) const TABLED: usize = 4096;
 
 /// The magnitude of a cell whose doubled gradient components square-sum to `s`: `sqrt(s / 4)`
 /// in `f32` (the sum of the halved components' squares is `s / 4` exactly), from a table made
 /// once below [`TABLED`].
 #[inline]
-fn magnitude(s: usize) -> f32 {
+pub(crate) fn magnitude(s: usize) -> f32 {
     static TABLE: std::sync::OnceLock<[f32; TABLED]> = std::sync::OnceLock::new();
     let root = |s: usize| ((s as f32) * 0.25).sqrt();
     match TABLE.get_or_init(|| std::array::from_fn(root)).get(s) {

@@ -34,7 +34,6 @@ pub struct VerticalEdges {
     /// Mean absolute horizontal difference (grey levels) an edge must exceed.
     pub threshold: f32,
     sums: Vec<u32>,
-    profile: Vec<f32>,
     found: Vec<Feature>,
     seq: u64,
 }
@@ -51,7 +50,7 @@ impl VerticalEdges {
     }
 
     pub fn new(band_half_rows: u32, threshold: f32) -> Self {
-        Self { band_half_rows, threshold, sums: Vec::new(), profile: Vec::new(), found: Vec::new(), seq: 0 }
+        Self { band_half_rows, threshold, sums: Vec::new(), found: Vec::new(), seq: 0 }
     }
 
     /// Runs on one frame (mono8 or rgb8, first channel used).
@@ -89,16 +88,16 @@ impl VerticalEdges {
                 }
             }
         }
-        self.profile.clear();
-        self.profile.extend(self.sums.iter().map(|&s| s as f32));
         let n_rows = rows.len() as f32;
         let mut features = [Feature::default(); MAX_FEATURES];
-        let profile = &self.profile;
+        // A column's mean difference over the band (0 beside the frame).
+        let sums = &self.sums;
+        let mean = |u: usize| sums.get(u).map_or(0.0, |&s| s as f32 / n_rows);
         self.found.clear();
         self.found.extend((0..w - 1).filter_map(|u| {
-            let s = profile[u] / n_rows;
-            let left = if u > 0 { profile[u - 1] / n_rows } else { 0.0 };
-            let right = profile.get(u + 1).map_or(0.0, |r| r / n_rows);
+            let s = mean(u);
+            let left = if u > 0 { mean(u - 1) } else { 0.0 };
+            let right = mean(u + 1);
             (s > self.threshold && s >= left && s > right).then_some(Feature {
                 x_px: u as f32 + 1.0,
                 y_px: mid as f32,
