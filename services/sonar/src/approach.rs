@@ -9,6 +9,12 @@
 //! The robot's pose at each reading's stamp comes from odometry (interpolated); while the robot
 //! turns, the axis sweeps over other things, so a window spanning a turn starts afresh, as does
 //! one whose range jumps (another surface).
+//! A streak of readings confirms an approach only while the object keeps coming: each reading
+//! after the first must be nearer than the streak's first by half the fitted approach speed
+//! (at least the least approach speed) over the time between, halfway between what a step and
+//! what a ramp would show. A smaller step onto a nearer surface tilts the fit of every window
+//! that holds it (three in a row, with four readings a window), but the readings after the
+//! step come no closer.
 
 use std::collections::VecDeque;
 
@@ -60,6 +66,8 @@ struct Window {
     last_stamp: u64,
     /// Consecutive readings that showed an approach within the time to contact.
     streak: u32,
+    /// The streak's first reading.
+    since: Reading,
 }
 
 impl Window {
@@ -185,7 +193,17 @@ impl Approach {
             let coming = approach >= self.p.min_approach_mps
                 && closing > 0.0
                 && f64::from(r) / closing <= self.p.ttc_s;
-            w.streak = if coming { w.streak + 1 } else { 0 };
+            let kept_coming = |s: &Reading| {
+                reading.compensated(s.p) - s.r
+                    <= -self.p.min_approach_mps.max(approach / 2.0) * (reading.t - s.t)
+            };
+            (w.streak, w.since) = match (coming, w.streak) {
+                (false, _) => (0, reading),
+                (true, 0) => (1, reading),
+                (true, n) if kept_coming(&w.since) => (n + 1, w.since),
+                // Coming by the fit, not by the readings since the streak began: a new streak.
+                (true, _) => (1, reading),
+            };
         }
     }
 

@@ -262,4 +262,6 @@ impl PanicAvoid {
 }
 
 #[cfg(test)]
+mod noise_tests;
+#[cfg(test)]
 mod tests;

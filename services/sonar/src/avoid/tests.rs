@@ -4,7 +4,7 @@
 use super::*;
 use harvey_msgs::Pose2;
 
-const P: AvoidParams = AvoidParams {
+pub(super) const P: AvoidParams = AvoidParams {
     ttc_s: 4.0,
     confirm: 3,
     min_approach_mps: 0.15,
@@ -16,7 +16,7 @@ const P: AvoidParams = AvoidParams {
 
 /// A ring read at `t` s: `ahead` m on sensor 0, `left` and `right` on sensors 6 and 18,
 /// 8 m elsewhere.
-fn ring(t: f64, ahead: f32, left: f32, right: f32) -> SonarRing {
+pub(super) fn ring(t: f64, ahead: f32, left: f32, right: f32) -> SonarRing {
     let mut r = SonarRing {
         header: Header::new(1, (t * 1e9) as u64),
         valid_mask: (1 << 24) - 1,
@@ -28,7 +28,7 @@ fn ring(t: f64, ahead: f32, left: f32, right: f32) -> SonarRing {
     r
 }
 
-fn odo(t: f64, x: f64, moving: bool, id: u32) -> Odometry {
+pub(super) fn odo(t: f64, x: f64, moving: bool, id: u32) -> Odometry {
     Odometry {
         header: Header::new(1, (t * 1e9) as u64),
         world_from_robot: Pose2 { x_m: x, ..Pose2::default() },
