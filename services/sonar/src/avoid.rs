@@ -94,8 +94,9 @@ pub struct PanicAvoid {
     approach: Approach,
     /// Set by the latest ring: some sensor (any bearing) confirmed an approach.
     approaching: bool,
-    /// Clearance at the left, right and straight ahead (m) from the latest ring.
+    /// Clearance at the left and right (m) from the latest ring.
     clearance: [f64; 2],
+    /// The nearest reading within the panic-stop's arc ahead (m).
     ahead_m: f64,
     /// The way to turn: +1 left, -1 right (away from the object, else to the clearer side).
     away: f64,
@@ -239,7 +240,12 @@ impl PanicAvoid {
         };
         let quarter = SONAR_SENSORS / 4;
         self.clearance = [side(quarter), side(3 * quarter)];
-        self.ahead_m = side(0);
+        // What the panic-stop watches (within 30 degrees of ahead): a dash longer than the
+        // nearest of it allows is cut short by the panic-stop, and another dash sent after it.
+        self.ahead_m = (0..SONAR_SENSORS)
+            .filter(|&i| bearing_rad(i).min(std::f64::consts::TAU - bearing_rad(i)) <= crate::FORWARD_ARC_RAD)
+            .map(side)
+            .fold(f64::INFINITY, f64::min);
         if trigger && self.phase == Phase::Watching {
             // Away from the side the approaching echoes come from; the clearer side on a tie.
             let side: f64 = (0..SONAR_SENSORS)

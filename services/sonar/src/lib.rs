@@ -10,7 +10,7 @@ use harvey_msgs::PANIC_STOP_IDS;
 use harvey_msgs::{CommandKind, Header, MotionCommand, SONAR_BANK_SIZE, SONAR_SENSORS, SonarRaw, SonarRing};
 
 /// Sensors whose axis lies within this angle of straight ahead watch for the panic-stop.
-const FORWARD_ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 + 1e-9;
+pub(crate) const FORWARD_ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 + 1e-9;
 
 /// Bearing of sensor `i`'s axis in the robot frame: evenly round the ring, 0 straight ahead.
 pub fn bearing_rad(i: usize) -> f64 {

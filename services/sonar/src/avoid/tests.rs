@@ -169,6 +169,22 @@ fn a_spurious_reading_or_a_slow_drift_does_not_trigger() {
 }
 
 #[test]
+fn a_dash_is_cut_short_of_what_the_panic_stop_watches_not_only_of_what_is_dead_ahead() {
+    let mut a = PanicAvoid::new(P);
+    bearing_down(&mut a, 4.0, 1.0);
+    let turn = a.on_odometry(&odo(2.0, 0.0, false, 7)).expect("turns");
+    assert_eq!(a.on_odometry(&odo(2.5, 0.0, true, turn.command_id)), None);
+    // Turned to face a doorway: straight ahead reads 3 m into the room, the sensor 15 degrees
+    // off reads its jamb 0.8 m away, which the panic-stop (30 degrees either way) watches.
+    let mut r = ring(3.0, 3.0, 1.0, 1.0);
+    r.range_m[1] = 0.8;
+    a.on_ring(&r);
+    let dash = a.on_odometry(&odo(3.5, 0.0, false, turn.command_id)).expect("dashes");
+    assert_eq!(dash.kind(), Some(CommandKind::Move));
+    assert!((dash.distance_m - (0.8 - P.stop_m - DASH_MARGIN_M)).abs() < 1e-6, "{dash:?}");
+}
+
+#[test]
 fn a_refused_turn_is_sent_again() {
     let mut a = PanicAvoid::new(P);
     bearing_down(&mut a, 4.0, 1.0);
