@@ -218,6 +218,7 @@ impl Rig {
         // sonar: last tick's odometry, this tick's banks; the ring and the reflexes.
         let mut reflexes = Vec::new();
         for o in std::mem::take(&mut self.odometry) {
+            self.ring.on_odometry(&o);
             reflexes.extend(self.avoid.on_odometry(&o));
         }
         let mut rings = Vec::new();

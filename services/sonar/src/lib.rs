@@ -1,5 +1,6 @@
 //! The sonar service's logic (001 §3, §6.1–6.2): assembles the 24-sensor ring from the DRV's
-//! banks of 8 and runs the panic-stop reflex, whose stop commands go straight to the vehicle;
+//! banks of 8 and runs the panic-stop reflex, whose stop commands go straight to the vehicle
+//! while it drives forward;
 //! the panic-avoid reflex is in `avoid.rs`.
 
 pub mod approach;
@@ -7,7 +8,9 @@ pub mod avoid;
 pub mod node;
 
 use harvey_msgs::PANIC_STOP_IDS;
-use harvey_msgs::{CommandKind, Header, MotionCommand, SONAR_BANK_SIZE, SONAR_SENSORS, SonarRaw, SonarRing};
+use harvey_msgs::{
+    CommandKind, Header, MotionCommand, Odometry, Pose2, SONAR_BANK_SIZE, SONAR_SENSORS, SonarRaw, SonarRing,
+};
 
 /// Sensors whose axis lies within this angle of straight ahead watch for the panic-stop.
 pub(crate) const FORWARD_ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 + 1e-9;
@@ -45,7 +48,18 @@ pub struct SonarRingBuilder {
     close_streak: [u8; SONAR_SENSORS],
     panicking: bool,
     seq: u64,
+    /// The vehicle's last odometry pose, and whether it advanced along its heading since the
+    /// one before.
+    #[serde(default)]
+    last_pose: Option<Pose2>,
+    #[serde(default)]
+    forward: bool,
 }
+
+/// The vehicle drives forward when its position advances along its heading by more than this
+/// between two odometry reports (m; the DRV reports hundredths of a foot, and a vehicle
+/// standing or turning on the spot reports the same position).
+const FORWARD_STEP_M: f64 = 0.001;
 
 /// A single close reading is not trusted: a Polaroid ring's crosstalk and multipath (001 §3)
 /// put a neighbour's short echo on a forward sensor now and then, and in a doorway that echo
@@ -67,7 +81,22 @@ impl SonarRingBuilder {
             close_streak: [0; SONAR_SENSORS],
             panicking: false,
             seq: 0,
+            last_pose: None,
+            forward: false,
         }
+    }
+
+    /// Odometry: whether the vehicle is driving forward. The panic-stop keeps the robot from
+    /// driving on into what is ahead (001 §6.2); a robot standing or turning on the spot
+    /// before a wall, or backing away from it, is not stopped (the stops, coming with every
+    /// bank, would cut short the turn that takes it away).
+    pub fn on_odometry(&mut self, o: &Odometry) {
+        let p = o.world_from_robot;
+        if let Some(q) = self.last_pose {
+            let (s, c) = q.heading_rad.sin_cos();
+            self.forward = (p.x_m - q.x_m) * c + (p.y_m - q.y_m) * s > FORWARD_STEP_M;
+        }
+        self.last_pose = Some(p);
     }
 
     /// Folds in one bank; rejects a bank number the DRV cannot send.
@@ -98,7 +127,7 @@ impl SonarRingBuilder {
         // 001 §6.2: stop commands keep coming while the obstacle is there.
         self.panicking = too_close;
         self.ring.panic_stop = u32::from(too_close);
-        let panic_stop = too_close.then(|| MotionCommand {
+        let panic_stop = (too_close && self.forward).then(|| MotionCommand {
             header: self.ring.header,
             kind: CommandKind::Stop as u32,
             urgent: 1,
@@ -138,9 +167,17 @@ mod tests {
         assert_eq!(e.to_string(), "sonar bank 3 does not exist (0..=2)");
     }
 
+    /// Odometry at `x` m along the x axis, heading `heading` radians.
+    fn odo(x: f64, heading: f64) -> Odometry {
+        Odometry { world_from_robot: Pose2 { x_m: x, y_m: 0.0, heading_rad: heading }, ..Odometry::default() }
+    }
+
     #[test]
     fn an_obstacle_ahead_stops_the_robot_until_it_goes() {
         let mut b = SonarRingBuilder::new(0.61);
+        // Driving forward at 0.3 m/s (odometry every 50 ms).
+        b.on_odometry(&odo(0.0, 0.0));
+        b.on_odometry(&odo(0.015, 0.0));
         let mut ranges = [5.0; 8];
         ranges[0] = 0.4; // sensor 0, straight ahead
         let u = b.on_bank(&bank(0, ranges, 10)).expect("valid");
@@ -165,5 +202,32 @@ mod tests {
             once.push(b.on_bank(&bank(0, ranges, 30 + k as u64)).expect("valid").panic_stop);
         }
         assert!(once.iter().all(Option::is_none));
+    }
+
+    #[test]
+    fn a_robot_standing_turning_or_backing_before_a_wall_is_not_stopped() {
+        let mut b = SonarRingBuilder::new(0.61);
+        let mut ranges = [5.0; 8];
+        ranges[0] = 0.5; // sensor 0, straight ahead
+        let bank0 = |b: &mut SonarRingBuilder, k: u64| b.on_bank(&bank(0, ranges, k)).expect("valid");
+        // Facing 90 degrees, standing, then turning on the spot, then backing away: the ring
+        // says the wall is too close ahead, and no stop is sent.
+        b.on_odometry(&odo(2.0, 1.57));
+        for (k, (x, heading)) in [(2.0, 1.57), (2.0, 1.5), (2.0, 1.4), (2.0, 1.3)].into_iter().enumerate() {
+            b.on_odometry(&odo(x, heading));
+            let u = bank0(&mut b, k as u64);
+            assert!(u.panic_stop.is_none(), "standing or turning, bank {k}");
+            assert_eq!(u.ring.panic_stop, u32::from(k >= 1), "the ring still tells, bank {k}");
+        }
+        let mut back = odo(2.0, 0.0);
+        back.world_from_robot.y_m = -0.02; // heading 0, moved sideways: not forward
+        b.on_odometry(&odo(2.0, 0.0));
+        b.on_odometry(&back);
+        assert!(bank0(&mut b, 10).panic_stop.is_none(), "sideways");
+        b.on_odometry(&odo(1.985, 0.0));
+        assert!(bank0(&mut b, 11).panic_stop.is_none(), "backing away");
+        // Driving on towards it: stopped.
+        b.on_odometry(&odo(2.0, 0.0));
+        assert!(bank0(&mut b, 12).panic_stop.is_some(), "driving forward");
     }
 }

@@ -58,6 +58,7 @@ impl Node for Sonar {
         io.take(self.odometry, &mut self.poses)?;
         io.take(self.raw, &mut self.banks)?;
         for o in &self.poses {
+            ring.on_odometry(o);
             if let Some(c) = avoid.as_mut().and_then(|a| a.on_odometry(o)) {
                 tracing::warn!(command = c.command_id, kind = c.kind, "panic-avoid");
                 io.send_as(self.commands, "panic-avoid", &c)?;
