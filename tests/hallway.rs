@@ -1,12 +1,16 @@
 //! 000 §5.5, Fig. 11 as missions: the straight run down the hallway in 2 ft increments. Servoed
 //! on the exit sign after each increment, the robot stays within 0.3 in of the line over 40 ft;
-//! open loop (002 Table 3's drift), it is over 2 in off by 18-20 ft.
+//! open loop (002 Table 3's drift), it is over 2 in off by 18-20 ft. With a cart coming at it, the
+//! panic-avoid evades and the servoed run, resumed where its increment began, regains the line.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
 
 use harvey_geometry::{FT, INCH};
-use harvey_msgs::{MissionStatus, ServoCorrection, ServoLevel, TruePose, VisionResult, VisionStatus};
+use harvey_msgs::{
+    CommandKind, MissionStatus, MotionCommand, ServoCorrection, ServoLevel, TruePose, VisionResult,
+    VisionStatus,
+};
 
 /// What a run recorded: the true poses (x, y along and across the line, which is the x axis),
 /// the executive's correlation results, its corrections, and the servo levels it reported.
@@ -15,6 +19,8 @@ struct Run {
     looks: Vec<VisionResult>,
     corrections: Vec<ServoCorrection>,
     levels: Vec<u32>,
+    /// The reflexes' commands.
+    reflexes: Vec<MotionCommand>,
 }
 
 fn run(mission: &str, tag: &str, steps: &str) -> Run {
@@ -30,8 +36,8 @@ fn decode(out: common::MissionRun, mission: &str, steps: &str) -> Run {
         out.stderr
     );
     let bytes = out.mcap.as_slice();
-    let (mut truth, mut looks, mut corrections, mut levels) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut truth, mut looks, mut corrections, mut levels, mut reflexes) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for m in mcap::MessageStream::new(bytes).expect("mcap") {
         let m = m.expect("message");
         match m.channel.topic.as_str() {
@@ -45,6 +51,7 @@ fn decode(out: common::MissionRun, mission: &str, steps: &str) -> Run {
             "/executive/status" => {
                 levels.push(harvey_cdr::decode::<MissionStatus>(&m.data).expect("status").servo)
             }
+            "/vehicle/reflex" => reflexes.push(harvey_cdr::decode::<MotionCommand>(&m.data).expect("reflex")),
             "/vision/results" => {
                 let r = harvey_cdr::decode::<VisionResult>(&m.data).expect("result");
                 if r.request_id >= 100 {
@@ -54,7 +61,7 @@ fn decode(out: common::MissionRun, mission: &str, steps: &str) -> Run {
             _ => {}
         }
     }
-    Run { truth, looks, corrections, levels }
+    Run { truth, looks, corrections, levels, reflexes }
 }
 
 /// The largest offset from the line over the stretch `from_ft ..= to_ft` of it.
@@ -68,7 +75,8 @@ fn worst(truth: &[[f64; 2]], from_ft: f64, to_ft: f64) -> f64 {
 
 #[test]
 fn servoing_holds_the_line_for_40_ft_where_open_loop_wanders_off_it() {
-    let Run { truth: servoed, looks, corrections, levels } = run("missions/hallway-40ft.toml", "h40", "1/1");
+    let Run { truth: servoed, looks, corrections, levels, .. } =
+        run("missions/hallway-40ft.toml", "h40", "1/1");
     let travelled = servoed.last().expect("truth")[0];
     let held = worst(&servoed, 0.0, 40.0);
     println!("servoed: {:.2} ft travelled, at most {:.3} in off the line", travelled / FT, held / INCH);
@@ -89,7 +97,7 @@ fn servoing_holds_the_line_for_40_ft_where_open_loop_wanders_off_it() {
     assert!(corrections.iter().all(|c| c.heading_error_rad.abs() < 2f64.to_radians()), "{corrections:?}");
     assert!(levels.contains(&(ServoLevel::Action as u32)), "action-level servoing reported");
 
-    let Run { truth: open, looks, corrections, levels } =
+    let Run { truth: open, looks, corrections, levels, .. } =
         run("missions/hallway-40ft-open.toml", "h40open", "1/1");
     assert!(corrections.is_empty() && levels.iter().all(|&l| l == ServoLevel::None as u32));
     let at_18_20 = worst(&open, 18.0, 20.0);
@@ -123,5 +131,30 @@ fn over_seeds_servoing_holds_the_line_within_its_budget() {
             assert!(held <= bound, "{condition} s{seed}: {held:.3} in off the line");
             assert_eq!(looks.len(), 21, "{condition} s{seed}");
         }
+    }
+}
+
+#[test]
+fn after_evading_a_cart_the_servoed_run_regains_the_line() {
+    for (condition, seed) in [("nominal", 1), ("nominal", 2), ("harsh", 1)] {
+        let mission = "missions/hallway-40ft-cart.toml";
+        let out = common::run_mission_under(mission, condition, seed, "h40cart");
+        let Run { truth, looks, reflexes, .. } = decode(out, mission, "1/1");
+        // The panic-avoid turned the robot aside (a right angle) about 4 m in.
+        let turn = reflexes.iter().find(|c| c.kind == CommandKind::Turn as u32).expect("an evasion");
+        assert!((turn.angle_rad.abs() - std::f64::consts::FRAC_PI_2).abs() < 1e-9, "{turn:?}");
+        let (late, end) = (worst(&truth, 20.0, 40.0) / INCH, truth.last().expect("truth")[1].abs() / INCH);
+        println!(
+            "{condition} s{seed}: {} looks, over the last 20 ft at most {late:.2} in off the line, {end:.2} in at the end",
+            looks.len()
+        );
+        // Back where the increment began and servoing again, a look after every increment.
+        // Servoing on a sign at the hall's end measures the heading, not the offset from the
+        // line: what the return by odometry left (the evasion's turns cost heading) stays. Over
+        // seeds 1..8 under nominal, dim and harsh (24 runs, all reaching the goal) the last
+        // 20 ft held within 1.0-5.1 in of the line (median 2.0), 0.3-2.3 in at the end; the
+        // undisturbed run holds 0.3-0.9 in.
+        assert!(looks.len() >= 21, "{condition} s{seed}: {} looks", looks.len());
+        assert!(late <= 6.0, "{condition} s{seed}: {late:.2} in off the line over the last 20 ft");
     }
 }

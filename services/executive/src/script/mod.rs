@@ -19,7 +19,7 @@ use crate::Progress;
 use crate::mission::{self, Step};
 use crate::servo::belief::Belief;
 use crate::servo::vertices::RefineSetup;
-use leg::{Leg, ServoSetup};
+use leg::{Leg, LegStep, ServoSetup};
 
 pub use refining::WAIT_NS;
 
@@ -123,8 +123,15 @@ pub struct Script {
     next_request: u32,
     /// Where the current step should leave the robot (for getting back to it after a reflex).
     step_goal: Pose2,
-    /// Primitives still to run to get back to `step_goal`, next last.
+    /// Primitives still to run to get back to `step_goal` (or, in a leg, to `leg_anchor`),
+    /// next last.
     recovery: Vec<(CommandKind, f64)>,
+    /// In a leg: its step under way and the believed pose it began from. A reflex's
+    /// interruption brings the robot back there and does the step again, so that a servoed
+    /// leg goes on looking and correcting instead of driving to the step's goal by odometry.
+    leg_anchor: Option<(Pose2, LegStep)>,
+    /// The leg's step to do again once `recovery` is run.
+    redo: Option<LegStep>,
     servo_seq: u64,
     /// Plan-level servoing: what `refine_pose` steps need, the vertices the current one asked
     /// for and what each look found.
@@ -164,6 +171,8 @@ impl Script {
             next_request: REQUEST_BASE,
             step_goal: Pose2::default(),
             recovery: Vec::new(),
+            leg_anchor: None,
+            redo: None,
             servo_seq: 0,
             refine: None,
             asked: Vec::new(),

@@ -1,7 +1,8 @@
 //! Getting back to the plan after a reflex took the vehicle (001 §6.2: once a panic-avoid
 //! episode is over, "special procedures are invoked to allow the robot to regain its bearings and
 //! then satisfy the previously specified navigational goals"): from where dead reckoning says
-//! the robot now is, face the interrupted step's goal, drive to it and take its heading.
+//! the robot now is, face the interrupted step's goal, drive to it and take its heading; or,
+//! back to a pose the robot has already been at (a leg's), back up to it if it is behind.
 
 use harvey_geometry::wrap;
 use harvey_msgs::{CommandKind, Pose2, REFLEX_ID_BIT};
@@ -15,19 +16,25 @@ pub fn is_reflex(command_id: u32) -> bool {
 pub const QUIET_NS: u64 = 2_000_000_000;
 
 /// The primitives from `at` to `goal`: TURN to face it, MOVE there, TURN to its heading (each
-/// left out when negligible), in order.
-pub fn back_to(at: Pose2, goal: Pose2) -> Vec<(CommandKind, f64)> {
+/// left out when negligible), in order. With `back_up`, a goal behind the robot is reached
+/// backwards (the TURN points its back at it, the MOVE is negative): for a pose the robot came
+/// from, whose way is known, this saves two turns, and every turn costs odometry heading.
+pub fn back_to(at: Pose2, goal: Pose2, back_up: bool) -> Vec<(CommandKind, f64)> {
     let (dx, dy) = (goal.x_m - at.x_m, goal.y_m - at.y_m);
     let d = dx.hypot(dy);
     let mut out = Vec::new();
     let mut heading = at.heading_rad;
     if d > 0.01 {
-        let face = wrap(dy.atan2(dx) - heading);
+        let mut face = wrap(dy.atan2(dx) - heading);
+        let backwards = back_up && face.abs() > std::f64::consts::FRAC_PI_2;
+        if backwards {
+            face = wrap(face - std::f64::consts::PI);
+        }
         if face.abs() > 1e-3 {
             out.push((CommandKind::Turn, face));
         }
         heading += face;
-        out.push((CommandKind::Move, d));
+        out.push((CommandKind::Move, if backwards { -d } else { d }));
     }
     let last = wrap(goal.heading_rad - heading);
     if last.abs() > 1e-3 {
@@ -45,13 +52,20 @@ mod tests {
         // Evaded: turned left a right angle and dashed 0.9 m; the step wanted (4, 0) heading 0.
         let at = Pose2 { x_m: 2.0, y_m: 0.9, heading_rad: std::f64::consts::FRAC_PI_2 };
         let goal = Pose2 { x_m: 4.0, y_m: 0.0, heading_rad: 0.0 };
-        let steps = back_to(at, goal);
+        let steps = back_to(at, goal, false);
         assert_eq!(steps.len(), 3);
         let face = -std::f64::consts::FRAC_PI_2 + (-0.9f64).atan2(2.0);
         assert!(steps[0].0 == CommandKind::Turn && (steps[0].1 - face).abs() < 1e-12);
         assert!(steps[1].0 == CommandKind::Move && (steps[1].1 - 2.0f64.hypot(0.9)).abs() < 1e-12);
         assert!(steps[2].0 == CommandKind::Turn && (steps[2].1 + (-0.9f64).atan2(2.0)).abs() < 1e-12);
-        assert!(back_to(goal, goal).is_empty());
+        assert!(back_to(goal, goal, false).is_empty());
+        // Backing up to a pose behind: the back turned towards it, then straight along.
+        let steps = back_to(at, goal, true);
+        let face = (-0.9f64).atan2(2.0) - std::f64::consts::FRAC_PI_2 + std::f64::consts::PI;
+        assert!(steps[0].0 == CommandKind::Turn && (steps[0].1 - face).abs() < 1e-12, "{steps:?}");
+        assert!(steps[1].0 == CommandKind::Move && (steps[1].1 + 2.0f64.hypot(0.9)).abs() < 1e-12);
+        let last = -(std::f64::consts::FRAC_PI_2 + face);
+        assert!(steps[2].0 == CommandKind::Turn && (steps[2].1 - last).abs() < 1e-12, "{steps:?}");
         assert!(is_reflex(0x8000_0003) && !is_reflex(3));
         assert!((wrap(3.5 * std::f64::consts::PI) + 0.5 * std::f64::consts::PI).abs() < 1e-12);
     }

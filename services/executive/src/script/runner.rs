@@ -55,6 +55,7 @@ impl Script {
         now: u64,
         sequel: &mut dyn Sequel,
     ) -> Vec<Output> {
+        self.leg_anchor = (next != LegStep::Done).then_some((at, next));
         match next {
             LegStep::Move(d) => vec![self.send(step, CommandKind::Move, d, 0.0, now)],
             LegStep::Turn(a) => {
@@ -143,7 +144,10 @@ impl Script {
         match self.recovery.pop() {
             Some((kind, v)) if kind == CommandKind::Move => vec![self.send(step, kind, v, 0.0, now)],
             Some((kind, v)) => vec![self.send(step, kind, 0.0, v, now)],
-            None => self.step_done(step, at, now, sequel),
+            None => match self.redo.take() {
+                Some(next) => self.apply(step, next, at, now, sequel),
+                None => self.step_done(step, at, now, sequel),
+            },
         }
     }
 
@@ -202,8 +206,11 @@ impl Script {
                 tracing::warn!(step, "a reflex took the vehicle; the step resumes once it is over");
                 self.preemptions += 1;
                 self.handled_reflex = reflex;
-                self.leg = None;
+                if self.leg_anchor.is_none() {
+                    self.leg = None;
+                }
                 self.recovery.clear();
+                self.redo = None;
                 self.phase = Phase::Preempted { step, since_ns: now };
                 Vec::new()
             }
@@ -211,11 +218,20 @@ impl Script {
                 if fresh_reflex {
                     self.handled_reflex = reflex;
                 }
-                if fresh_reflex || o.moving != 0 || o.command_accepted == 0 {
+                // Quiet: no new reflex command and the vehicle still. Not whether it took the
+                // newest command: odometry names the newest published, which is often a reflex's
+                // stop sent beside the step the vehicle ran, and never taken.
+                if fresh_reflex || o.moving != 0 {
                     self.phase = Phase::Preempted { step, since_ns: now };
                     Vec::new()
                 } else if now.saturating_sub(since_ns) >= recover::QUIET_NS {
-                    self.recovery = recover::back_to(at, self.step_goal);
+                    self.recovery = match self.leg_anchor.filter(|_| self.leg.is_some()) {
+                        Some((anchor, next)) => {
+                            self.redo = Some(next);
+                            recover::back_to(at, anchor, true)
+                        }
+                        None => recover::back_to(at, self.step_goal, false),
+                    };
                     self.recovery.reverse();
                     self.resume(step, at, now, sequel)
                 } else {
@@ -224,7 +240,7 @@ impl Script {
             }
             Phase::Executing { step, id } => {
                 let finished = o.command.command_id == id && o.command_accepted == 1 && o.moving == 0;
-                if finished && !self.recovery.is_empty() {
+                if finished && (!self.recovery.is_empty() || self.redo.is_some()) {
                     self.resume(step, at, now, sequel)
                 } else if finished {
                     match self.leg.as_mut() {

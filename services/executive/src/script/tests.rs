@@ -211,6 +211,65 @@ fn after_a_reflex_the_interrupted_step_is_finished_from_where_the_robot_is() {
 }
 
 #[test]
+fn a_reflex_stop_the_vehicle_never_took_does_not_hold_the_step_for_ever() {
+    let mut e = script(60.0, vec![Step { move_m: Some(4.0), ..Step::default() }]);
+    let mv = commands(&e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false)))[0];
+    e.on_odometry(&odo(1.0, 1.0, mv, true, true));
+    // The panic-avoid's last dash ran, and odometry names a stop sent beside it, which the
+    // vehicle never reported running: still, and that stop is the newest command for good.
+    let stop = MotionCommand { command_id: 0xC000_0009, urgent: 1, ..MotionCommand::default() };
+    assert!(commands(&e.on_odometry(&odo(2.0, 1.5, stop, false, false))).is_empty());
+    assert!(commands(&e.on_odometry(&odo(3.0, 1.5, stop, false, false))).is_empty(), "quiet for 1 s");
+    let go = commands(&e.on_odometry(&odo(4.1, 1.5, stop, false, false)));
+    assert!(go.len() == 1 && (go[0].distance_m - 2.5).abs() < 1e-9, "quiet for 2 s: on to the goal: {go:?}");
+}
+
+#[test]
+fn after_a_reflex_a_servoed_leg_does_its_increment_again_from_where_it_began() {
+    let mut e = servoed();
+    let mv = commands(&e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false)))[0];
+    assert_eq!(mv.distance_m, 0.6);
+    // 0.3 m into the first increment the panic-avoid turns the robot right and dashes 0.4 m.
+    let reflex =
+        |id: u32| MotionCommand { command_id: 0x8000_0000 | id, urgent: 1, ..MotionCommand::default() };
+    e.on_odometry(&odo(1.0, 0.3, mv, true, true));
+    e.on_odometry(&odo(1.5, 0.3, reflex(1), true, false));
+    let mut at = odo(6.0, 0.3, reflex(3), true, false);
+    at.world_from_robot = Pose2 { x_m: 0.3, y_m: -0.4, heading_rad: -std::f64::consts::FRAC_PI_2 };
+    e.on_odometry(&at);
+    at.header.stamp_ns = 8_500_000_000;
+    // Back (backing up: it came from there) to where the increment began, facing along the
+    // line: not on to the step's goal.
+    let mut pose = at.world_from_robot;
+    let mut sent = Vec::new();
+    let mut cmd = commands(&e.on_odometry(&at))[0];
+    for k in 0..4 {
+        sent.push((cmd.kind, cmd.distance_m, cmd.angle_rad));
+        match CommandKind::from_raw(cmd.kind) {
+            Some(CommandKind::Turn) => pose.heading_rad += cmd.angle_rad,
+            _ => pose = pose.arc(cmd.distance_m, 0.0),
+        }
+        let mut done = odo(10.0 + 2.0 * f64::from(k), 0.0, cmd, true, false);
+        done.world_from_robot = pose;
+        let out = e.on_odometry(&done);
+        if k == 3 {
+            let Output::Look(look) = out[0] else { panic!("then the look: {out:?}") };
+            assert!((look.expected.x_m - 0.6).abs() < 1e-12 && look.expected.y_m == 0.0, "{look:?}");
+            break;
+        }
+        cmd = commands(&out)[0];
+    }
+    let kinds: Vec<u32> = sent.iter().map(|s| s.0).collect();
+    let (turn, mv) = (CommandKind::Turn as u32, CommandKind::Move as u32);
+    assert_eq!(kinds, [turn, mv, turn, mv], "{sent:?}");
+    assert!((sent[1].1 + 0.5).abs() < 1e-9, "backing up 0.5 m: {sent:?}");
+    assert!((sent[3].1 - 0.6).abs() < 1e-12, "the increment again: {sent:?}");
+    assert!((pose.x_m - 0.6).abs() < 1e-9 && pose.y_m.abs() < 1e-9, "{pose:?}");
+    assert!(pose.heading_rad.sin().abs() < 1e-9 && pose.heading_rad.cos() > 0.0, "{pose:?}");
+    assert_eq!(preemptions(&e), 1);
+}
+
+#[test]
 fn a_mission_past_its_time_fails_and_stops_the_robot() {
     let mut e = script(5.0, two_steps());
     let out = e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false));
