@@ -156,5 +156,6 @@ fn after_evading_a_cart_the_servoed_run_regains_the_line() {
         // undisturbed run holds 0.3-0.9 in.
         assert!(looks.len() >= 21, "{condition} s{seed}: {} looks", looks.len());
         assert!(late <= 6.0, "{condition} s{seed}: {late:.2} in off the line over the last 20 ft");
+        assert!(end <= 3.0, "{condition} s{seed}: {end:.2} in off the line at the end");
     }
 }

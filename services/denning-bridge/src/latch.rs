@@ -27,8 +27,10 @@ struct Evasion {
 
 /// After an urgent stop, commands that would drive the vehicle forward, stamped within
 /// `hold_ns` of it, are refused (unless urgent themselves: the panic-avoid's), so that no old
-/// or new motion command slips in while the sonar keeps reporting the obstacle ahead (it
-/// re-sends the stop with every ring). Turning on the spot and backing away are let through:
+/// or new motion command slips in while the vehicle is brought to a stop (the sonar re-sends
+/// the stop with every ring while the vehicle still drives forward; once it stands, the
+/// executive holds back its forward commands while the ring says the way ahead is too close).
+/// Turning on the spot and backing away are let through:
 /// without them a robot stopped before a wall would stay there. While the panic-avoid evades
 /// (its stop, turn, dash and holding stops) every command but a reflex's is refused: an
 /// executive's command would replace the reflex's step on the vehicle, or find it busy.

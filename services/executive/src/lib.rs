@@ -136,11 +136,13 @@ impl Executive {
         }
     }
 
-    /// A sonar ring (the behaviours' obstacles and ranges).
+    /// A sonar ring (the behaviours' obstacles and ranges; a script's way out after a reflex).
     pub fn on_sonar(&mut self, r: &SonarRing) {
         self.sonar_rings_seen += 1;
-        if let Mode::Sequenced(run) = &mut self.mode {
-            run.behaviour.on_sonar(r);
+        match &mut self.mode {
+            Mode::Sequenced(run) => run.behaviour.on_sonar(r),
+            Mode::Script(s) => s.on_sonar(r),
+            Mode::Plan(p) => p.script.on_sonar(r),
         }
     }
 

@@ -124,7 +124,9 @@ impl SonarRingBuilder {
             let ahead = b.min(std::f64::consts::TAU - b) <= FORWARD_ARC_RAD;
             ahead && self.close_streak[i] >= self.confirm
         });
-        // 001 §6.2: stop commands keep coming while the obstacle is there.
+        // 001 §6.2: stop commands keep coming while the obstacle is there and the vehicle
+        // drives on towards it (standing or turning away, it is not stopped again; the
+        // executive does not send it forward into what the ring's flag says is too close).
         self.panicking = too_close;
         self.ring.panic_stop = u32::from(too_close);
         let panic_stop = (too_close && self.forward).then(|| MotionCommand {

@@ -5,6 +5,7 @@
 //! comes after the last step is the [`Sequel`]'s: nothing for a plain script, more steps for
 //! plan-and-monitor.
 
+mod clearance;
 pub mod leg;
 pub mod recover;
 mod refining;
@@ -49,7 +50,8 @@ pub(crate) enum Phase {
         received: u32,
         since_ns: u64,
     },
-    /// A sonar reflex took the vehicle during step `i`; it last moved at `since_ns`.
+    /// A sonar reflex took the vehicle during step `i`; since `since_ns` no new reflex command
+    /// came and the vehicle kept still (or the way ahead was blocked when it was to go on).
     Preempted {
         step: usize,
         since_ns: u64,
@@ -126,12 +128,15 @@ pub struct Script {
     /// Primitives still to run to get back to `step_goal` (or, in a leg, to `leg_anchor`),
     /// next last.
     recovery: Vec<(CommandKind, f64)>,
-    /// In a leg: its step under way and the believed pose it began from. A reflex's
-    /// interruption brings the robot back there and does the step again, so that a servoed
-    /// leg goes on looking and correcting instead of driving to the step's goal by odometry.
+    /// In a leg (servoed or open loop): its step under way and the believed pose it began from.
+    /// A reflex's interruption brings the robot back there and does the step again, so that a
+    /// servoed leg goes on looking and correcting instead of driving to the step's goal by
+    /// odometry.
     leg_anchor: Option<(Pose2, LegStep)>,
     /// The leg's step to do again once `recovery` is run.
     redo: Option<LegStep>,
+    /// The latest sonar ring's way ahead and behind.
+    clearance: clearance::Clearance,
     servo_seq: u64,
     /// Plan-level servoing: what `refine_pose` steps need, the vertices the current one asked
     /// for and what each look found.
@@ -173,6 +178,7 @@ impl Script {
             recovery: Vec::new(),
             leg_anchor: None,
             redo: None,
+            clearance: clearance::Clearance::default(),
             servo_seq: 0,
             refine: None,
             asked: Vec::new(),
@@ -187,6 +193,11 @@ impl Script {
             estimated: Pose2::default(),
             next_id: 1,
         }
+    }
+
+    /// A sonar ring: the way ahead and behind for getting back after a reflex.
+    pub fn on_sonar(&mut self, ring: &harvey_msgs::SonarRing) {
+        self.clearance = clearance::Clearance::of(ring);
     }
 
     /// With plan-level servoing: what `refine_pose` steps need.

@@ -2,7 +2,8 @@
 //! episode is over, "special procedures are invoked to allow the robot to regain its bearings and
 //! then satisfy the previously specified navigational goals"): from where dead reckoning says
 //! the robot now is, face the interrupted step's goal, drive to it and take its heading; or,
-//! back to a pose the robot has already been at (a leg's), back up to it if it is behind.
+//! back to a pose the robot has already been at (a leg's), back up to it if it is behind and
+//! the way behind is clear.
 
 use harvey_geometry::wrap;
 use harvey_msgs::{CommandKind, Pose2, REFLEX_ID_BIT};
@@ -16,17 +17,17 @@ pub fn is_reflex(command_id: u32) -> bool {
 pub const QUIET_NS: u64 = 2_000_000_000;
 
 /// The primitives from `at` to `goal`: TURN to face it, MOVE there, TURN to its heading (each
-/// left out when negligible), in order. With `back_up`, a goal behind the robot is reached
-/// backwards (the TURN points its back at it, the MOVE is negative): for a pose the robot came
-/// from, whose way is known, this saves two turns, and every turn costs odometry heading.
-pub fn back_to(at: Pose2, goal: Pose2, back_up: bool) -> Vec<(CommandKind, f64)> {
+/// left out when negligible), in order. A goal behind the robot and at most `max_back_m` away
+/// is reached backwards (the TURN points its back at it, the MOVE is negative): for a pose the
+/// robot came from this turns it half a turn less, and every turn costs odometry heading.
+pub fn back_to(at: Pose2, goal: Pose2, max_back_m: f64) -> Vec<(CommandKind, f64)> {
     let (dx, dy) = (goal.x_m - at.x_m, goal.y_m - at.y_m);
     let d = dx.hypot(dy);
     let mut out = Vec::new();
     let mut heading = at.heading_rad;
     if d > 0.01 {
         let mut face = wrap(dy.atan2(dx) - heading);
-        let backwards = back_up && face.abs() > std::f64::consts::FRAC_PI_2;
+        let backwards = d <= max_back_m && face.abs() > std::f64::consts::FRAC_PI_2;
         if backwards {
             face = wrap(face - std::f64::consts::PI);
         }
@@ -52,15 +53,16 @@ mod tests {
         // Evaded: turned left a right angle and dashed 0.9 m; the step wanted (4, 0) heading 0.
         let at = Pose2 { x_m: 2.0, y_m: 0.9, heading_rad: std::f64::consts::FRAC_PI_2 };
         let goal = Pose2 { x_m: 4.0, y_m: 0.0, heading_rad: 0.0 };
-        let steps = back_to(at, goal, false);
+        let steps = back_to(at, goal, 0.0);
         assert_eq!(steps.len(), 3);
         let face = -std::f64::consts::FRAC_PI_2 + (-0.9f64).atan2(2.0);
         assert!(steps[0].0 == CommandKind::Turn && (steps[0].1 - face).abs() < 1e-12);
         assert!(steps[1].0 == CommandKind::Move && (steps[1].1 - 2.0f64.hypot(0.9)).abs() < 1e-12);
         assert!(steps[2].0 == CommandKind::Turn && (steps[2].1 + (-0.9f64).atan2(2.0)).abs() < 1e-12);
-        assert!(back_to(goal, goal, false).is_empty());
+        assert!(back_to(goal, goal, 0.0).is_empty());
+        assert_eq!(back_to(at, goal, 2.0), steps, "2.19 m behind, 2 m clear: forwards");
         // Backing up to a pose behind: the back turned towards it, then straight along.
-        let steps = back_to(at, goal, true);
+        let steps = back_to(at, goal, 2.5);
         let face = (-0.9f64).atan2(2.0) - std::f64::consts::FRAC_PI_2 + std::f64::consts::PI;
         assert!(steps[0].0 == CommandKind::Turn && (steps[0].1 - face).abs() < 1e-12, "{steps:?}");
         assert!(steps[1].0 == CommandKind::Move && (steps[1].1 + 2.0f64.hypot(0.9)).abs() < 1e-12);

@@ -141,6 +141,19 @@ impl Script {
 
     /// The next primitive of the way back to the interrupted step's goal, or the next step.
     fn resume(&mut self, step: usize, at: Pose2, now: u64, sequel: &mut dyn Sequel) -> Vec<Output> {
+        // The panic-stop stops only a vehicle driving forward: into what it sees too close
+        // ahead, a MOVE would creep a few centimetres a try. And none watches behind: a MOVE
+        // backing further than the ring shows clear (the cart that was evaded, going by) waits
+        // too, until the way is clear.
+        let d = match (self.recovery.last(), self.redo) {
+            (Some(&(CommandKind::Move, d)), _) => d,
+            (None, Some(LegStep::Move(d))) => d,
+            _ => 0.0,
+        };
+        if (d > 0.0 && self.clearance.blocked_ahead) || -d > self.clearance.may_back_m() {
+            self.phase = Phase::Preempted { step, since_ns: now };
+            return Vec::new();
+        }
         match self.recovery.pop() {
             Some((kind, v)) if kind == CommandKind::Move => vec![self.send(step, kind, v, 0.0, now)],
             Some((kind, v)) => vec![self.send(step, kind, 0.0, v, now)],
@@ -225,12 +238,14 @@ impl Script {
                     self.phase = Phase::Preempted { step, since_ns: now };
                     Vec::new()
                 } else if now.saturating_sub(since_ns) >= recover::QUIET_NS {
-                    self.recovery = match self.leg_anchor.filter(|_| self.leg.is_some()) {
-                        Some((anchor, next)) => {
-                            self.redo = Some(next);
-                            recover::back_to(at, anchor, true)
+                    self.recovery = match (self.leg_anchor, self.leg.as_mut()) {
+                        (Some((anchor, next)), Some(leg)) => {
+                            // Back at the leg's start by odometry, the heading is not the line's
+                            // as the mount's measurement needs: the mount stays as configured.
+                            self.redo = Some(if leg.discovering() { leg.skip_calibration() } else { next });
+                            recover::back_to(at, anchor, f64::INFINITY)
                         }
-                        None => recover::back_to(at, self.step_goal, false),
+                        _ => recover::back_to(at, self.step_goal, 0.0),
                     };
                     self.recovery.reverse();
                     self.resume(step, at, now, sequel)

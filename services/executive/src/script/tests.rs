@@ -224,12 +224,29 @@ fn a_reflex_stop_the_vehicle_never_took_does_not_hold_the_step_for_ever() {
     assert!(go.len() == 1 && (go[0].distance_m - 2.5).abs() < 1e-9, "quiet for 2 s: on to the goal: {go:?}");
 }
 
-#[test]
-fn after_a_reflex_a_servoed_leg_does_its_increment_again_from_where_it_began() {
+/// A sonar ring reading `behind_m` all round (what matters: behind), the panic-stop's flag as
+/// `blocked`.
+fn ring(behind_m: f32, blocked: bool) -> harvey_msgs::SonarRing {
+    let n = harvey_msgs::SONAR_SENSORS;
+    let mut r = harvey_msgs::SonarRing {
+        valid_mask: (1 << n) - 1,
+        panic_stop: u32::from(blocked),
+        ..Default::default()
+    };
+    for i in 0..n {
+        r.bearing_rad[i] = (i as f64 * std::f64::consts::TAU / n as f64) as f32;
+        r.range_m[i] = behind_m;
+    }
+    r
+}
+
+/// A servoed leg whose first increment a reflex interrupts 0.3 m in (a right turn and a 0.4 m
+/// dash), the ring reading `behind_m` behind: the primitives of the recovery and the redone
+/// increment, and where they leave the robot, once the leg looks again.
+fn recover_leg(behind_m: f32) -> (Vec<(u32, f64, f64)>, Pose2, Executive) {
     let mut e = servoed();
     let mv = commands(&e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false)))[0];
     assert_eq!(mv.distance_m, 0.6);
-    // 0.3 m into the first increment the panic-avoid turns the robot right and dashes 0.4 m.
     let reflex =
         |id: u32| MotionCommand { command_id: 0x8000_0000 | id, urgent: 1, ..MotionCommand::default() };
     e.on_odometry(&odo(1.0, 0.3, mv, true, true));
@@ -237,9 +254,8 @@ fn after_a_reflex_a_servoed_leg_does_its_increment_again_from_where_it_began() {
     let mut at = odo(6.0, 0.3, reflex(3), true, false);
     at.world_from_robot = Pose2 { x_m: 0.3, y_m: -0.4, heading_rad: -std::f64::consts::FRAC_PI_2 };
     e.on_odometry(&at);
+    e.on_sonar(&ring(behind_m, false));
     at.header.stamp_ns = 8_500_000_000;
-    // Back (backing up: it came from there) to where the increment began, facing along the
-    // line: not on to the step's goal.
     let mut pose = at.world_from_robot;
     let mut sent = Vec::new();
     let mut cmd = commands(&e.on_odometry(&at))[0];
@@ -259,14 +275,69 @@ fn after_a_reflex_a_servoed_leg_does_its_increment_again_from_where_it_began() {
         }
         cmd = commands(&out)[0];
     }
-    let kinds: Vec<u32> = sent.iter().map(|s| s.0).collect();
+    (sent, pose, e)
+}
+
+#[test]
+fn after_a_reflex_a_servoed_leg_does_its_increment_again_from_where_it_began() {
     let (turn, mv) = (CommandKind::Turn as u32, CommandKind::Move as u32);
-    assert_eq!(kinds, [turn, mv, turn, mv], "{sent:?}");
+    // The way behind clear for 3 m: back (it came from there) to where the increment began,
+    // facing along the line, not on to the step's goal; then the increment again.
+    let (sent, pose, e) = recover_leg(3.0);
+    assert_eq!(sent.iter().map(|s| s.0).collect::<Vec<_>>(), [turn, mv, turn, mv], "{sent:?}");
     assert!((sent[1].1 + 0.5).abs() < 1e-9, "backing up 0.5 m: {sent:?}");
     assert!((sent[3].1 - 0.6).abs() < 1e-12, "the increment again: {sent:?}");
     assert!((pose.x_m - 0.6).abs() < 1e-9 && pose.y_m.abs() < 1e-9, "{pose:?}");
     assert!(pose.heading_rad.sin().abs() < 1e-9 && pose.heading_rad.cos() > 0.0, "{pose:?}");
     assert_eq!(preemptions(&e), 1);
+}
+
+#[test]
+fn a_recovery_backs_up_only_as_far_as_the_way_behind_is_clear() {
+    // Turned to back up 0.5 m to where the increment began, with something 0.6 m behind (0.3 m
+    // clear, with the margin): it waits, and backs up once the way is clear.
+    let mut e = servoed();
+    let mv = commands(&e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false)))[0];
+    let reflex =
+        |id: u32| MotionCommand { command_id: 0x8000_0000 | id, urgent: 1, ..MotionCommand::default() };
+    e.on_odometry(&odo(1.0, 0.3, mv, true, true));
+    e.on_odometry(&odo(1.5, 0.3, reflex(1), true, false));
+    let mut at = odo(6.0, 0.3, reflex(3), true, false);
+    at.world_from_robot = Pose2 { x_m: 0.3, y_m: -0.4, heading_rad: -std::f64::consts::FRAC_PI_2 };
+    e.on_odometry(&at);
+    e.on_sonar(&ring(0.6, false));
+    at.header.stamp_ns = 8_500_000_000;
+    let turn = commands(&e.on_odometry(&at))[0];
+    assert_eq!(turn.kind, CommandKind::Turn as u32);
+    let mut done = odo(10.0, 0.0, turn, true, false);
+    done.world_from_robot.heading_rad = at.world_from_robot.heading_rad + turn.angle_rad;
+    (done.world_from_robot.x_m, done.world_from_robot.y_m) = (0.3, -0.4);
+    assert!(commands(&e.on_odometry(&done)).is_empty(), "waits: 0.3 m clear behind");
+    done.header.stamp_ns = 13_000_000_000;
+    assert!(commands(&e.on_odometry(&done)).is_empty(), "still waits");
+    e.on_sonar(&ring(3.0, false));
+    done.header.stamp_ns = 15_100_000_000;
+    let back = commands(&e.on_odometry(&done));
+    assert!(back.len() == 1 && (back[0].distance_m + 0.5).abs() < 1e-9, "{back:?}");
+}
+
+#[test]
+fn after_a_reflex_no_move_goes_out_into_what_the_panic_stop_sees_ahead() {
+    // Stopped by the panic-stop 2 m into a 4 m move, before something that stays: the vehicle
+    // stands, the panic-stop sends no more stops, and the way ahead stays blocked.
+    let mut e = script(60.0, vec![Step { move_m: Some(4.0), ..Step::default() }]);
+    let mv = commands(&e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false)))[0];
+    let stop = MotionCommand { command_id: 0xC000_0001, urgent: 1, ..MotionCommand::default() };
+    e.on_odometry(&odo(1.0, 1.0, mv, true, true));
+    e.on_sonar(&ring(3.0, true));
+    for t in [2.0, 5.0, 8.0, 11.0] {
+        assert!(commands(&e.on_odometry(&odo(t, 2.0, stop, true, false))).is_empty(), "at {t} s");
+    }
+    // Gone: on to the goal after quiet.
+    e.on_sonar(&ring(3.0, false));
+    assert!(commands(&e.on_odometry(&odo(12.0, 2.0, stop, true, false))).is_empty(), "quiet again first");
+    let go = commands(&e.on_odometry(&odo(14.1, 2.0, stop, true, false)));
+    assert!(go.len() == 1 && (go[0].distance_m - 2.0).abs() < 1e-9, "{go:?}");
 }
 
 #[test]

@@ -62,9 +62,10 @@ fn a_step_onto_a_nearer_surface_is_no_approach() {
             assert_eq!(fired, 0, "step {step} m, noise +-{amp} m");
         }
     }
-    // At harsh's noise (+-5 cm, sd 2.9 cm) a streak of noise now and then keeps closing.
+    // At harsh's noise (+-5 cm, sd 2.9 cm) a streak of noise could keep closing by chance (in
+    // none of another 1000 draws; 3 of 1000 at +-8 cm); before, 16 % of the draws fired.
     let fired = draws(Scene::Step(0.28), 0.05, 400).iter().filter(|f| f.is_some()).count();
-    assert!(fired <= 16, "{fired} of 400 draws fired");
+    assert!(fired <= 4, "{fired} of 400 draws fired");
 }
 
 #[test]
