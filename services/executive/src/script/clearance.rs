@@ -10,14 +10,21 @@ use harvey_msgs::SonarRing;
 /// 2 ft, 001 §6.2, at the same slow speed).
 pub const BACKING_MARGIN_M: f64 = 0.3;
 
-/// Sensors within this angle of straight behind watch the way back (the panic-stop's 30 degrees
+/// The panic-stop watches the readings within this angle of ahead; the same angle of straight
+/// behind watches the way back (the panic-stop's 30 degrees
 /// either way, turned round).
-const REAR_ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 + 1e-9;
+const ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 + 1e-6;
+
+/// The panic-stop watches 30 degrees either way of ahead; what it sees nearest within 15 degrees
+/// is in the robot's way (at its 2 ft a reading 15 degrees off is 0.16 m to the side, inside the
+/// robot's 0.23 m radius; 30 degrees off, 0.3 m: a doorway's jamb beside the way through).
+const PATH_ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 / 2.0 + 1e-6;
 
 /// The latest ring's reading of the way ahead and behind.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Clearance {
-    /// The ring's panic-stop flag: a reading ahead under the panic-stop's distance.
+    /// The ring's panic-stop flag (a reading ahead under the panic-stop's distance), with the
+    /// nearest reading ahead in the robot's way, not beside it.
     pub blocked_ahead: bool,
     /// The nearest valid reading within 30 degrees of straight behind (m; infinite if none).
     pub behind_m: f64,
@@ -32,15 +39,22 @@ impl Default for Clearance {
 
 impl Clearance {
     pub fn of(ring: &SonarRing) -> Self {
-        let behind_m = (0..ring.range_m.len())
-            .filter(|&i| ring.valid_mask & (1 << i) != 0)
-            .filter(|&i| {
-                let off = harvey_geometry::wrap(f64::from(ring.bearing_rad[i]) - std::f64::consts::PI);
-                off.abs() <= REAR_ARC_RAD
-            })
-            .map(|i| f64::from(ring.range_m[i]))
-            .fold(f64::INFINITY, f64::min);
-        Self { blocked_ahead: ring.panic_stop != 0, behind_m }
+        // The nearest valid reading within `arc` of `towards`: its range and bearing off it.
+        let nearest = |towards: f64, arc: f64| {
+            (0..ring.range_m.len())
+                .filter(|&i| ring.valid_mask & (1 << i) != 0)
+                .map(|i| {
+                    (
+                        f64::from(ring.range_m[i]),
+                        harvey_geometry::wrap(f64::from(ring.bearing_rad[i]) - towards),
+                    )
+                })
+                .filter(|&(_, off)| off.abs() <= arc)
+                .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a })
+        };
+        let (_, ahead_off) = nearest(0.0, ARC_RAD);
+        let (behind_m, _) = nearest(std::f64::consts::PI, ARC_RAD);
+        Self { blocked_ahead: ring.panic_stop != 0 && ahead_off.abs() <= PATH_ARC_RAD, behind_m }
     }
 
     /// How far the robot may back up.
@@ -65,6 +79,15 @@ mod tests {
             r.range_m[i] = ranges(i);
         }
         r
+    }
+
+    #[test]
+    fn the_way_ahead_is_blocked_by_what_is_in_the_robots_way_not_by_a_jamb_beside_it() {
+        // The panic-stop's flag with the nearest reading dead ahead, 15 degrees off, 30 off.
+        let near = |k: usize| Clearance::of(&ring(move |i| if i == k { 0.5 } else { 3.0 }, true));
+        assert!(near(0).blocked_ahead && near(1).blocked_ahead && near(23).blocked_ahead);
+        assert!(!near(2).blocked_ahead && !near(22).blocked_ahead, "a jamb 30 degrees off");
+        assert!(!Clearance::of(&ring(|_| 0.5, false)).blocked_ahead, "no flag, no block");
     }
 
     #[test]

@@ -17,9 +17,10 @@ pub fn is_reflex(command_id: u32) -> bool {
 pub const QUIET_NS: u64 = 2_000_000_000;
 
 /// The primitives from `at` to `goal`: TURN to face it, MOVE there, TURN to its heading (each
-/// left out when negligible), in order. A goal behind the robot and at most `max_back_m` away
-/// is reached backwards (the TURN points its back at it, the MOVE is negative): for a pose the
-/// robot came from this turns it half a turn less, and every turn costs odometry heading.
+/// left out when negligible), in order. A goal at most `max_back_m` away is reached backwards
+/// (the TURN points the robot's back at it, the MOVE is negative) when that turns it less in
+/// all: every turn costs odometry heading, and for a pose the robot came from along its heading
+/// backing saves up to a whole turn.
 pub fn back_to(at: Pose2, goal: Pose2, max_back_m: f64) -> Vec<(CommandKind, f64)> {
     let (dx, dy) = (goal.x_m - at.x_m, goal.y_m - at.y_m);
     let d = dx.hypot(dy);
@@ -27,9 +28,11 @@ pub fn back_to(at: Pose2, goal: Pose2, max_back_m: f64) -> Vec<(CommandKind, f64
     let mut heading = at.heading_rad;
     if d > 0.01 {
         let mut face = wrap(dy.atan2(dx) - heading);
-        let backwards = d <= max_back_m && face.abs() > std::f64::consts::FRAC_PI_2;
+        let turning = |face: f64| face.abs() + wrap(goal.heading_rad - heading - face).abs();
+        let back_face = wrap(face - std::f64::consts::PI);
+        let backwards = d <= max_back_m && turning(back_face) < turning(face);
         if backwards {
-            face = wrap(face - std::f64::consts::PI);
+            face = back_face;
         }
         if face.abs() > 1e-3 {
             out.push((CommandKind::Turn, face));
@@ -60,14 +63,21 @@ mod tests {
         assert!(steps[1].0 == CommandKind::Move && (steps[1].1 - 2.0f64.hypot(0.9)).abs() < 1e-12);
         assert!(steps[2].0 == CommandKind::Turn && (steps[2].1 + (-0.9f64).atan2(2.0)).abs() < 1e-12);
         assert!(back_to(goal, goal, 0.0).is_empty());
-        assert_eq!(back_to(at, goal, 2.0), steps, "2.19 m behind, 2 m clear: forwards");
-        // Backing up to a pose behind: the back turned towards it, then straight along.
-        let steps = back_to(at, goal, 2.5);
-        let face = (-0.9f64).atan2(2.0) - std::f64::consts::FRAC_PI_2 + std::f64::consts::PI;
-        assert!(steps[0].0 == CommandKind::Turn && (steps[0].1 - face).abs() < 1e-12, "{steps:?}");
-        assert!(steps[1].0 == CommandKind::Move && (steps[1].1 + 2.0f64.hypot(0.9)).abs() < 1e-12);
-        let last = -(std::f64::consts::FRAC_PI_2 + face);
-        assert!(steps[2].0 == CommandKind::Turn && (steps[2].1 - last).abs() < 1e-12, "{steps:?}");
+        // Backing would turn it 222 degrees in all, forwards 138: forwards, however clear.
+        assert_eq!(back_to(at, goal, 10.0), steps);
+        // Turned right and dashed 0.4 m, 0.3 m into a step from (0, 0): forwards it turns 270
+        // degrees in all, backing 90.
+        let at = Pose2 { x_m: 0.3, y_m: -0.4, heading_rad: -std::f64::consts::FRAC_PI_2 };
+        let start = Pose2::default();
+        let back = back_to(at, start, 0.5);
+        let face = (0.4f64).atan2(-0.3) + std::f64::consts::FRAC_PI_2 - std::f64::consts::PI;
+        assert!(back[0].0 == CommandKind::Turn && (back[0].1 - face).abs() < 1e-12, "{back:?}");
+        assert!(back[1].0 == CommandKind::Move && (back[1].1 + 0.5).abs() < 1e-12, "{back:?}");
+        assert!(
+            back[2].0 == CommandKind::Turn && (back[2].1 + face - std::f64::consts::FRAC_PI_2).abs() < 1e-12
+        );
+        let ahead = back_to(at, start, 0.4);
+        assert!(ahead[1].0 == CommandKind::Move && (ahead[1].1 - 0.5).abs() < 1e-12, "not clear: {ahead:?}");
         assert!(is_reflex(0x8000_0003) && !is_reflex(3));
         assert!((wrap(3.5 * std::f64::consts::PI) + 0.5 * std::f64::consts::PI).abs() < 1e-12);
     }
