@@ -155,30 +155,27 @@ fn a_stereo_pair_is_one_stacked_image_read_back_as_a_pair() {
     assert!(e.to_string().contains("stereo pair of 3 rows"), "{e}");
 }
 
+/// A 2x2 rgb8 image's CDR with rows of `step` bytes.
+fn rgb8_2x2(step: u32) -> Vec<u8> {
+    let mut w = CdrWriter::start(Vec::new());
+    write_std_header(7, "camera", &mut w);
+    w.prim(2u32);
+    w.prim(2u32);
+    w.string("rgb8");
+    w.prim(0u8);
+    w.prim(step);
+    w.byte_seq(&vec![0; 2 * step as usize]);
+    w.finish()
+}
+
 #[test]
 fn an_image_whose_rows_are_shorter_than_its_pixels_is_refused() {
     // Two rgb8 pixels a row (6 bytes) in rows of 2 bytes: a reader taking each row's pixels
     // would run past the data.
-    let mut w = CdrWriter::start(Vec::new());
-    write_std_header(7, "camera", &mut w);
-    w.prim(2u32);
-    w.prim(2u32);
-    w.string("rgb8");
-    w.prim(0u8);
-    w.prim(2u32);
-    w.byte_seq(&[0; 4]);
-    let e = decode_image(&w.finish()).expect_err("rows too short");
+    let e = decode_image(&rgb8_2x2(2)).expect_err("rows too short");
     assert!(e.to_string().contains("row step of 2 bytes for 2 rgb8 pixels (6 bytes)"), "{e}");
     // Rows longer than their pixels (padding) are an image.
-    let mut w = CdrWriter::start(Vec::new());
-    write_std_header(7, "camera", &mut w);
-    w.prim(2u32);
-    w.prim(2u32);
-    w.string("rgb8");
-    w.prim(0u8);
-    w.prim(8u32);
-    w.byte_seq(&[0; 16]);
-    let padded = w.finish();
+    let padded = rgb8_2x2(8);
     let (h, px) = decode_image(&padded).expect("padded rows");
     assert_eq!((h.stride_bytes, px.len()), (8, 16));
 }

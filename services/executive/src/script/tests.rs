@@ -240,10 +240,10 @@ fn ring(behind_m: f32, blocked: bool) -> harvey_msgs::SonarRing {
     r
 }
 
-/// A servoed leg whose first increment a reflex interrupts 0.3 m in (a right turn and a 0.4 m
-/// dash), the ring reading `behind_m` behind: the primitives of the recovery and the redone
-/// increment, and where they leave the robot, once the leg looks again.
-fn recover_leg(behind_m: f32) -> (Vec<(u32, f64, f64)>, Pose2, Executive) {
+/// A servoed leg whose first increment (0.6 m) a reflex interrupts 0.3 m in (a right turn and a
+/// 0.4 m dash), the ring reading `behind_m` behind; and the odometry, quiet long enough, that
+/// sets it on the way back.
+fn interrupted_leg(behind_m: f32) -> (Executive, Odometry) {
     let mut e = servoed();
     let mv = commands(&e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false)))[0];
     assert_eq!(mv.distance_m, 0.6);
@@ -256,6 +256,14 @@ fn recover_leg(behind_m: f32) -> (Vec<(u32, f64, f64)>, Pose2, Executive) {
     e.on_odometry(&at);
     e.on_sonar(&ring(behind_m, false));
     at.header.stamp_ns = 8_500_000_000;
+    (e, at)
+}
+
+/// A servoed leg whose first increment a reflex interrupts 0.3 m in (a right turn and a 0.4 m
+/// dash), the ring reading `behind_m` behind: the primitives of the recovery and the redone
+/// increment, and where they leave the robot, once the leg looks again.
+fn recover_leg(behind_m: f32) -> (Vec<(u32, f64, f64)>, Pose2, Executive) {
+    let (mut e, at) = interrupted_leg(behind_m);
     let mut pose = at.world_from_robot;
     let mut sent = Vec::new();
     let mut cmd = commands(&e.on_odometry(&at))[0];
@@ -296,17 +304,7 @@ fn after_a_reflex_a_servoed_leg_does_its_increment_again_from_where_it_began() {
 fn a_recovery_backs_up_only_as_far_as_the_way_behind_is_clear() {
     // Turned to back up 0.5 m to where the increment began, with something 0.6 m behind (0.3 m
     // clear, with the margin): it waits, and backs up once the way is clear.
-    let mut e = servoed();
-    let mv = commands(&e.on_odometry(&odo(0.0, 0.0, MotionCommand::default(), false, false)))[0];
-    let reflex =
-        |id: u32| MotionCommand { command_id: 0x8000_0000 | id, urgent: 1, ..MotionCommand::default() };
-    e.on_odometry(&odo(1.0, 0.3, mv, true, true));
-    e.on_odometry(&odo(1.5, 0.3, reflex(1), true, false));
-    let mut at = odo(6.0, 0.3, reflex(3), true, false);
-    at.world_from_robot = Pose2 { x_m: 0.3, y_m: -0.4, heading_rad: -std::f64::consts::FRAC_PI_2 };
-    e.on_odometry(&at);
-    e.on_sonar(&ring(0.6, false));
-    at.header.stamp_ns = 8_500_000_000;
+    let (mut e, at) = interrupted_leg(0.6);
     let turn = commands(&e.on_odometry(&at))[0];
     assert_eq!(turn.kind, CommandKind::Turn as u32);
     let mut done = odo(10.0, 0.0, turn, true, false);
