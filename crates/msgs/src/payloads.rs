@@ -140,6 +140,9 @@ message!(MotionCommand);
 pub const REFLEX_ID_BIT: u32 = 0x8000_0000;
 /// The panic-stop's ids have the two top bits set; the panic-avoid's only the top one.
 pub const PANIC_STOP_IDS: u32 = 0xC000_0000;
+/// The panic-stop watches the sonar sensors whose axis lies within this angle of straight
+/// ahead (the forward five of 24); a ring's `panic_stop` flag is theirs.
+pub const PANIC_STOP_ARC_RAD: f64 = std::f64::consts::FRAC_PI_6;
 
 impl MotionCommand {
     pub fn kind(&self) -> Option<CommandKind> {

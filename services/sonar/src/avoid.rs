@@ -242,10 +242,8 @@ impl PanicAvoid {
         self.clearance = [side(quarter), side(3 * quarter)];
         // What the panic-stop watches (within 30 degrees of ahead): a dash longer than the
         // nearest of it allows is cut short by the panic-stop, and another dash sent after it.
-        self.ahead_m = (0..SONAR_SENSORS)
-            .filter(|&i| bearing_rad(i).min(std::f64::consts::TAU - bearing_rad(i)) <= crate::FORWARD_ARC_RAD)
-            .map(side)
-            .fold(f64::INFINITY, f64::min);
+        self.ahead_m =
+            (0..SONAR_SENSORS).filter(|&i| crate::watched_ahead(i)).map(side).fold(f64::INFINITY, f64::min);
         if trigger && self.phase == Phase::Watching {
             // Away from the side the approaching echoes come from; the clearer side on a tie.
             let side: f64 = (0..SONAR_SENSORS)

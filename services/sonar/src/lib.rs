@@ -12,8 +12,11 @@ use harvey_msgs::{
     CommandKind, Header, MotionCommand, Odometry, Pose2, SONAR_BANK_SIZE, SONAR_SENSORS, SonarRaw, SonarRing,
 };
 
-/// Sensors whose axis lies within this angle of straight ahead watch for the panic-stop.
-pub(crate) const FORWARD_ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 + 1e-9;
+/// Whether sensor `i` is one the panic-stop watches (within `PANIC_STOP_ARC_RAD` of ahead).
+pub(crate) fn watched_ahead(i: usize) -> bool {
+    let b = bearing_rad(i);
+    b.min(std::f64::consts::TAU - b) <= harvey_msgs::PANIC_STOP_ARC_RAD + 1e-9
+}
 
 /// Bearing of sensor `i`'s axis in the robot frame: evenly round the ring, 0 straight ahead.
 pub fn bearing_rad(i: usize) -> f64 {
@@ -119,11 +122,7 @@ impl SonarRingBuilder {
         }
         self.seq += 1;
         self.ring.header = Header::new(self.seq, raw.header.stamp_ns);
-        let too_close = (0..SONAR_SENSORS).any(|i| {
-            let b = bearing_rad(i);
-            let ahead = b.min(std::f64::consts::TAU - b) <= FORWARD_ARC_RAD;
-            ahead && self.close_streak[i] >= self.confirm
-        });
+        let too_close = (0..SONAR_SENSORS).any(|i| watched_ahead(i) && self.close_streak[i] >= self.confirm);
         // 001 §6.2: stop commands keep coming while the obstacle is there and the vehicle
         // drives on towards it (standing or turning away, it is not stopped again; the
         // executive does not send it forward into what the ring's flag says is too close).

@@ -10,15 +10,14 @@ use harvey_msgs::SonarRing;
 /// 2 ft, 001 §6.2, at the same slow speed).
 pub const BACKING_MARGIN_M: f64 = 0.3;
 
-/// The panic-stop watches the readings within this angle of ahead; the same angle of straight
-/// behind watches the way back (the panic-stop's 30 degrees
-/// either way, turned round).
-const ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 + 1e-6;
+/// The readings within this angle of ahead are the panic-stop's; the same angle of straight
+/// behind watches the way back (the bearings are f32: a millionth of a radian of slack).
+const ARC_RAD: f64 = harvey_msgs::PANIC_STOP_ARC_RAD + 1e-6;
 
 /// The panic-stop watches 30 degrees either way of ahead; what it sees nearest within 15 degrees
 /// is in the robot's way (at its 2 ft a reading 15 degrees off is 0.16 m to the side, inside the
 /// robot's 0.23 m radius; 30 degrees off, 0.3 m: a doorway's jamb beside the way through).
-const PATH_ARC_RAD: f64 = std::f64::consts::FRAC_PI_6 / 2.0 + 1e-6;
+const PATH_ARC_RAD: f64 = harvey_msgs::PANIC_STOP_ARC_RAD / 2.0 + 1e-6;
 
 /// The latest ring's reading of the way ahead and behind.
 #[derive(Debug, Clone, Copy, PartialEq)]
