@@ -21,11 +21,13 @@ mod nc_pass;
 pub mod noise;
 pub mod odometry;
 pub mod path;
+pub mod path_steps;
 pub mod pyramid;
 pub mod regions;
 mod register;
 mod run_pass;
 pub mod simd;
+pub mod step_line;
 pub mod stereo;
 pub mod unique;
 

@@ -31,6 +31,12 @@ impl ImageLine {
         if s.abs() < 1e-6 { self.point[0] } else { self.point[0] + (v - self.point[1]) * c / s }
     }
 
+    /// The y where the line crosses column `u` (a vertical line: its point's y).
+    pub fn y_at(&self, u: f32) -> f32 {
+        let (c, s) = (self.angle.cos(), self.angle.sin());
+        if c.abs() < 1e-6 { self.point[1] } else { self.point[1] + (u - self.point[0]) * s / c }
+    }
+
     /// Where two lines cross.
     pub fn cross(&self, o: &ImageLine) -> Option<[f32; 2]> {
         let (d1, d2) = ([self.angle.cos(), self.angle.sin()], [o.angle.cos(), o.angle.sin()]);
