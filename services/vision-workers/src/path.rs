@@ -1,12 +1,15 @@
 //! The path-following request (001 §2.1, `VisionAlgorithm::Path`): the line finder's fragments in
 //! the window grouped into the path's two edges by a tracker kept per request id, bootstrapped
-//! from the request's predicted edges and fed forward from each confident fit.
+//! from the request's predicted edges and fed forward from each confident fit. A fit whose edges
+//! do not step in the frame (a checker's diagonals grouped on a dim, noisy day), or none, gives way
+//! to the edges' steps searched near the prediction (`harvey_vision::path_steps`).
 
 use std::collections::BTreeMap;
 
 use harvey_msgs::{VisionRequest, VisionStatus};
 use harvey_vision::flf::{Flf, FlfParams};
 use harvey_vision::path::{ImageLine, PathParams, PathTracker};
+use harvey_vision::path_steps::StepSearch;
 use harvey_vision::{Gray, Rect};
 
 /// The line finder's settings for path edges: fragments of at least this length (px), at this
@@ -25,6 +28,7 @@ type Started = ([f32; 8], [f32; 2]);
 #[derive(Debug, Default)]
 pub struct PathTrackers {
     trackers: BTreeMap<u32, (Started, PathTracker)>,
+    steps: StepSearch,
 }
 
 impl PathTrackers {
@@ -79,7 +83,8 @@ impl PathTrackers {
             ..FlfParams::default()
         };
         let lines = flf.lines(img, window, &flf_params).map_err(|e| crate::dispatch::status_of(&e))?;
-        if let Some(fit) = tracker.update(lines) {
+        let fit = tracker.update_checked(lines, img, window, &mut self.steps);
+        if let Some(fit) = fit {
             let c = fit.centreline;
             push([fit.vanishing[0], fit.vanishing[1], c.x_at(bottom), bottom, fit.confidence, 0.0]);
             for e in [fit.left, fit.right] {
