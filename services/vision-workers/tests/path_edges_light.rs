@@ -275,23 +275,21 @@ fn the_path_s_edges_give_heading_and_offset_on_every_surface_whatever_the_light(
             along.add(row);
             let what = format!("{} {segment} {surface}", c.0);
             assert!(row.asked >= 40, "{what}: {} asked", row.asked);
-            // Gravel against dry grass steps some 25 grey levels in the harsh light (170, noise
-            // of sd 8), under the recogniser's four noise deviations: lost there, and so are the
-            // gravel edges ahead of a robot on the concrete. Everywhere else nearly every look
-            // found it (94 % or more on these runs).
-            let lost = c.0 == "harsh" && *surface != "tile";
-            if !lost {
-                assert!(row.found() >= 0.9, "{what}: {:.1} % found", 100.0 * row.found());
-            }
+            // Gravel against dry grass steps some 16-25 grey levels in the harsh light (170, noise
+            // of sd 8): a column shows it no more than its noise, the line summed along the
+            // columns does (`harvey_vision::step_line`). Every row along the segments found it on
+            // 96 % of the looks or more on these runs (the step-by-column search before it: 0 %
+            // on the harsh gravel, 56 % on the harsh concrete).
+            assert!(row.found() >= 0.9, "{what}: {:.1} % found", 100.0 * row.found());
             // Half the answers within 0.15 degrees and 6 mm on these runs.
             if !row.errors.is_empty() {
                 assert!(median(row.col(0)) <= 0.3f64.to_radians(), "{what}: median heading error");
                 assert!(median(row.col(1)) <= 0.015, "{what}: median offset error");
             }
         }
-        // 97 % or more of a row's answers within three of their deviations, 0.6 % past five (a
-        // gravel edge outshone by the concrete-to-gravel line across the path, a corner of the
-        // window where the edge is short): bars with room for other seeds.
+        // 98 % or more of a row's answers within three of their deviations, and one of some 500
+        // past five (harsh, on the bend's gravel; with the step-by-column search before, 13 of
+        // 1500 over the three conditions): bars with room for other seeds.
         let n = along.errors.len().max(1) as f64;
         assert!(along.within(3.0) >= 0.95, "{}: {:.1} % within 3 sd", c.0, 100.0 * along.within(3.0));
         assert!(along.blunders() as f64 <= 0.015 * n, "{}: {} past 5 sd", c.0, along.blunders());

@@ -74,14 +74,14 @@ impl Band {
             .collect()
     }
 
-    /// Whether the image gets darker going down a column across the edge, for a line seen on
-    /// the robot's left (`seen_left`: the robot, heading along the line within 90 degrees,
-    /// stands on its right) or right. Going down a column runs from the far side to the near.
-    pub fn darker_below(&self, seen_left: bool) -> bool {
+    /// Whether the image gets darker going down a column across the edge, for the robot standing
+    /// on the line's right (`robot_right`, looking from its first end to its second) or on its
+    /// left. Going down a column runs from the far side to the near.
+    pub fn darker_below(&self, robot_right: bool) -> bool {
         match self.edge {
             Edge::Baseboard { darker } => darker,
             Edge::Floor { left, right } => {
-                let (near, far) = if seen_left { (right, left) } else { (left, right) };
+                let (near, far) = if robot_right { (right, left) } else { (left, right) };
                 near < far
             }
         }
@@ -139,7 +139,8 @@ mod tests {
             let (l, r) = if lawn_left { (lawn, path) } else { (path, lawn) };
             assert!((left - l).abs() < 1e-9 && (right - r).abs() < 1e-9, "{name}: {b:?}");
             assert!((b.below_camera_m - 1.2).abs() < 1e-9 && (b.height_sd_m - 0.01).abs() < 1e-12);
-            // Seen on the left the robot is on the path's side: brighter going down the column.
+            // A lawn on the line's left: the robot on its right stands on the path, brighter going
+            // down the column.
             assert!(!b.darker_below(lawn_left) && b.darker_below(!lawn_left), "{name}");
         }
         assert_eq!(bands.iter().filter(|b| b.is_some()).count(), 6);

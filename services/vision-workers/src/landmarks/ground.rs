@@ -2,28 +2,44 @@
 //! foot with its baseboard, or a floor edge where two floors meet (a path's edge on its lawn).
 //! The map (`band.rs`) gives the edge's height below the camera (a band's top, or the floor) and
 //! which way it steps going down an image column (a band darker than the wall above it; for a
-//! floor edge, the near floor's reflectance less the far one's). Column by column, the strongest
-//! step of that sign going down (below the horizon) is the edge; each edge point is projected
+//! floor edge, the near floor's reflectance less the far one's). The edge is the straight image
+//! line (below the horizon) along which the step of that sign going down the columns, summed,
+//! stands out most (`harvey_vision::step_line`: a faint edge no column shows alone is found so),
+//! and each column's own strongest step near it an edge point; each edge point is projected
 //! onto the plane of the edge's height, giving points on the floor plan in the robot's frame; a
 //! line fitted to them with its outliers trimmed (a doorway, a tile's edge) gives the robot's
 //! heading relative to the line and its signed distance from it (left positive). The robot is
 //! taken to head along the line's direction (its first end to its second) within 90 degrees:
 //! the landmark's view headings say so. So a line seen on the left (the window's middle left of
-//! the image's) has the robot on its right, which is the near side of a floor edge.
+//! the image's) has the robot on its right, which is the near side of a floor edge; and its
+//! image then descends to the left.
 
 use harvey_msgs::{Expectation, FrameHeader, Header, LandmarkSighting, SightingKind};
 use harvey_vision::levels::{histogram, percentile};
 use harvey_vision::noise::noise_sigma;
+use harvey_vision::step_line::{HALF_ROWS, MAX_ANGLE, Profiles};
 use harvey_vision::{Gray, Rect};
 use harvey_world::World;
 
 use super::band::Band;
 
-/// A column's edge counts when its step (three rows' means either side) is this many noise
-/// deviations (five of the step's own), and this fraction of the window's median grey, past
-/// nothing.
-const NOISE_SIGMAS: f32 = 4.0;
+/// The edge's line counts when its step summed along it is this many times what noise summed over
+/// as many columns would reach (`step_line.rs`), and its mean step this fraction of the window's
+/// median grey; a column's own edge then counts within `BAND_ROWS` of the line when its step
+/// (three rows' means either side) is this many noise deviations and that fraction past nothing.
+const MIN_Z: f32 = 8.0;
 const MIN_STEP: f32 = 0.15;
+const BAND_ROWS: f32 = 3.0;
+const NEAR_SIGMAS: f32 = 1.5;
+/// A window with fewer rows within `MAX_DEPTH_M` than this shows too little of the floor for a
+/// line: in a strip of a few rows at the far limit any stretch of texture sums to one.
+const MIN_ROWS: usize = 16;
+/// A line further than this from the robot's heading (rad) runs across the view, where a path's
+/// joints across it and the far floors' edges are as likely as the line looked for: the robot
+/// heads along its line (the landmark's view headings).
+const MAX_HEADING_RAD: f64 = std::f64::consts::FRAC_PI_3;
+/// Lines tried, best first, until one's points give a fit.
+const LINES_TRIED: usize = 3;
 /// Columns looked at: every second one.
 const COLUMN_STEP: usize = 2;
 /// A fit needs this many points over this much depth (m), nearer than `MAX_DEPTH_M`; a point off
@@ -41,6 +57,9 @@ pub struct GroundLines {
     /// How well the mount's yaw and pitch are known (rad).
     calibration_sd_rad: f64,
     points: Vec<[f64; 2]>,
+    profiles: Profiles,
+    scratch: Vec<(f32, u32)>,
+    spread: Vec<f32>,
 }
 
 impl GroundLines {
@@ -50,6 +69,9 @@ impl GroundLines {
             focal_px: world.camera.focal_px,
             calibration_sd_rad,
             points: Vec::new(),
+            profiles: Profiles::default(),
+            scratch: Vec::new(),
+            spread: Vec::new(),
         }
     }
 
@@ -68,32 +90,6 @@ impl GroundLines {
         // Below the horizon only: the band's edge lies under the camera.
         let top = v0.max(cy as usize + 3);
         let win = Rect::new(u0, top, u1.min(w), v1.min(ht)).inside(w, ht).ok()?;
-        let median = f32::from(percentile(&histogram(&img, win), 0.5));
-        let least = (NOISE_SIGMAS * noise_sigma(&img, win)).max(MIN_STEP * median);
-        let darker = band.darker_below(((win.x0 + win.x1) as f64) / 2.0 < cx);
-        self.points.clear();
-        for u in (win.x0..win.x1).step_by(COLUMN_STEP) {
-            let at = |v: usize| f32::from(img.at(u, v));
-            // The step across row v: the mean of the three rows below less that of the three
-            // above (a blurred edge spreads over the middle row), negative where it goes darker.
-            let step = |v: usize| {
-                let s = (at(v + 1) + at(v + 2) + at(v + 3) - at(v - 1) - at(v - 2) - at(v - 3)) / 3.0;
-                if darker { -s } else { s }
-            };
-            let rows = win.y0 + 3..win.y1.saturating_sub(3);
-            let best = rows.clone().map(|v| (v, step(v))).max_by(|a, b| a.1.total_cmp(&b.1));
-            let Some((v, peak)) = best.filter(|b| b.1 >= least) else { continue };
-            // A sharp edge between rows k - 1 and k steps as much at both: the edge runs through
-            // the middle of the rows near the peak, weighted by their step.
-            let near = (v.saturating_sub(2).max(rows.start)..(v + 3).min(rows.end)).map(|r| (r, step(r)));
-            let (sum, weight) = near
-                .filter(|&(_, s)| s >= peak / 2.0)
-                .fold((0.0, 0.0), |(a, w), (r, s)| (a + (r as f64 + 0.5) * f64::from(s), w + f64::from(s)));
-            let depth = f * band.below_camera_m / (sum / weight - cy);
-            if depth > 0.0 && depth < MAX_DEPTH_M {
-                self.points.push([depth, depth * (cx - (u as f64 + 0.5)) / f]);
-            }
-        }
         let base = LandmarkSighting {
             header: Header::new(0, h.stamp_ns),
             frame_seq: h.seq,
@@ -101,7 +97,53 @@ impl GroundLines {
             ..Default::default()
         };
         let not_found = LandmarkSighting { kind: SightingKind::NotFound as u32, ..base };
-        let Some(fit) = fit_trimmed(&mut self.points) else { return Some(not_found) };
+        // And no higher than where the edge lies `MAX_DEPTH_M` off: a further edge gives no points.
+        let nearest_row = cy + f * band.below_camera_m / MAX_DEPTH_M;
+        let top = top.max((nearest_row as usize).saturating_sub(HALF_ROWS));
+        let Ok(win) = Rect::new(u0, top, win.x1, win.y1).inside(w, ht) else { return Some(not_found) };
+        if win.height() < MIN_ROWS {
+            return Some(not_found);
+        }
+        let median = f32::from(percentile(&histogram(&img, win), 0.5));
+        let noise = noise_sigma(&img, win);
+        // The edge is a straight line in the image: the line whose summed step stands out of the
+        // noise, then each column's own step near it. A line seen on the left (the window's
+        // middle left of the image's) is taken to have the robot on its right, which says which
+        // floor of a floor edge is near (going down a column is coming nearer along the floor).
+        // A line descending to the left in the image has the robot on its right, one descending
+        // to the right on its left (towards its far end, its vanishing point, it rises): lines
+        // of the other slope are not it (a parallel edge of the other sign, looked at from
+        // where the guess of side is wrong).
+        let robot_right = ((win.x0 + win.x1) as f64) / 2.0 < cx;
+        let slopes = if robot_right { (-MAX_ANGLE, 0.0) } else { (0.0, MAX_ANGLE) };
+        self.profiles.measure(&img, win, COLUMN_STEP, band.darker_below(robot_right));
+        let spread = self.profiles.spread(&mut self.spread);
+        let least = (NEAR_SIGMAS * noise).max(MIN_STEP * median);
+        let mut fit = None;
+        // The best line may be another straight edge of the same sign (where a path's concrete
+        // meets its gravel, across it): one whose points give no fit is set aside for the next.
+        for _ in 0..LINES_TRIED {
+            let line = self.profiles.best_line(slopes, &mut self.scratch);
+            let Some(line) =
+                line.filter(|l| l.z(spread) >= MIN_Z && l.sum >= MIN_STEP * median * l.columns as f32)
+            else {
+                break;
+            };
+            self.points.clear();
+            for (c, &u) in self.profiles.columns.iter().enumerate() {
+                let Some(row) = self.profiles.peak_near(c, &line.line, BAND_ROWS, least) else { continue };
+                let depth = f * band.below_camera_m / (row - cy);
+                if depth > 0.0 && depth < MAX_DEPTH_M {
+                    self.points.push([depth, depth * (cx - (u as f64 + 0.5)) / f]);
+                }
+            }
+            fit = fit_trimmed(&mut self.points);
+            if fit.is_some() {
+                break;
+            }
+            self.profiles.suppress(&line.line, BAND_ROWS);
+        }
+        let Some(fit) = fit.filter(|f| f.b.atan().abs() <= MAX_HEADING_RAD) else { return Some(not_found) };
         // The line y = a + b x in the robot's frame, along +x: the robot's heading less the
         // line's direction is -atan b; its distance from the line, left positive, -a / |(1, b)|.
         let norm = fit.b.hypot(1.0);
