@@ -38,6 +38,10 @@ const MIN_ROWS: usize = 16;
 /// joints across it and the far floors' edges are as likely as the line looked for: the robot
 /// heads along its line (the landmark's view headings).
 const MAX_HEADING_RAD: f64 = std::f64::consts::FRAC_PI_3;
+/// A fit whose offset at the robot is known no better than this (m, its own spread and its
+/// slope's carried to the points' mean depth) is a stretch of texture or a far floor's edge
+/// rather than the line: the edges found within reach are known to a few centimetres.
+const MAX_SPREAD_M: f64 = 0.2;
 /// Lines tried, best first, until one's points give a fit.
 const LINES_TRIED: usize = 3;
 /// Columns looked at: every second one.
@@ -143,7 +147,8 @@ impl GroundLines {
             }
             self.profiles.suppress(&line.line, BAND_ROWS);
         }
-        let Some(fit) = fit.filter(|f| f.b.atan().abs() <= MAX_HEADING_RAD) else { return Some(not_found) };
+        let plausible = |f: &Fit| f.b.atan().abs() <= MAX_HEADING_RAD && f.a_sd.hypot(f.b_sd * f.mean_x) <= MAX_SPREAD_M;
+        let Some(fit) = fit.filter(plausible) else { return Some(not_found) };
         // The line y = a + b x in the robot's frame, along +x: the robot's heading less the
         // line's direction is -atan b; its distance from the line, left positive, -a / |(1, b)|.
         let norm = fit.b.hypot(1.0);
