@@ -1,7 +1,7 @@
 //! Path following in the campus (001 §2.1) as a mission, `missions/path-follow.toml`: 61 m along
-//! the path through two bends by the line finder's centreline, swept over seeds under the
-//! nominal and dim cameras (the harsh one loses the gravel's edges: docs/evaluation.md) and
-//! judged from each recording against the simulator's truth:
+//! the path through two bends by the line finder's centreline (the edges' summed steps where its
+//! fit fails), swept over seeds under the nominal, dim and harsh cameras and judged from each
+//! recording against the simulator's truth:
 //! the robot reaches the path's end and keeps near the true centreline (median and worst); and
 //! the UMS's map is smaller with the path's edges as class III landmarks than with the lampposts
 //! alone (`missions/path-follow-class-i.toml`, the campus counterpart of 002 Fig. 79 vs 80).
@@ -93,23 +93,28 @@ fn sweep(mission: &str, tag: &str, seeds: &str, conditions: &[&str]) -> Vec<(Str
     })
 }
 
-// Over seeds 1..3 of each camera the robot kept within 0.003-0.021 m of the centreline (median),
-// 0.41 m at worst, at a bend (the 3 m path leaves it 1.27 m a side); over seeds 1..10 of each
-// every run reached the end (docs/evaluation.md).
+// Over seeds 1..3 of each camera the robot kept within 0.002-0.013 m of the centreline (median),
+// 0.18 m at worst, at a bend (the 3 m path leaves it 1.27 m a side); over seeds 1..10 every
+// nominal and dim run reached the end (docs/evaluation.md).
 
 #[test]
 fn the_robot_follows_the_campus_path_through_both_bends_and_class_iii_shrinks_the_map() {
     let seeds = "1..3";
-    let rows = sweep("missions/path-follow.toml", "pathfw", seeds, &["nominal", "dim"]);
-    // Every run reaches the end, and kept near the centreline.
+    let mut rows = sweep("missions/path-follow.toml", "pathfw", seeds, &["nominal", "dim"]);
+    rows.extend(sweep("missions/path-follow.toml", "pathfh", seeds, &["harsh"]));
+    // Every run that reaches the end kept near the centreline.
     let mut misses = Vec::new();
     for (c, seed, reached, f) in &rows {
         if *reached && (f.end_m > 0.5 || f.worst_m > 0.5 || f.median_m > 0.15) {
             misses.push(format!("{c} s{seed}: {f:?}"));
         }
     }
+    // Every nominal and dim run reaches the end; under harsh, two of the three at least (harsh
+    // seed 2 loses the path near the end of the gravel bend: 8 of 10 over seeds 1..10,
+    // docs/evaluation.md).
     let lost: Vec<String> = rows.iter().filter(|r| !r.2).map(|r| format!("{} s{}", r.0, r.1)).collect();
-    if !lost.is_empty() {
+    let lost_harsh = rows.iter().filter(|r| !r.2 && r.0 == "harsh").count();
+    if lost.len() > lost_harsh || lost_harsh > 1 {
         misses.push(format!("lost the path: {lost:?}"));
     }
     // The campus counterpart of 002 Fig. 79 vs 80: the same runs with the lampposts alone. Their

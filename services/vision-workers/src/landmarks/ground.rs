@@ -147,7 +147,8 @@ impl GroundLines {
             }
             self.profiles.suppress(&line.line, BAND_ROWS);
         }
-        let plausible = |f: &Fit| f.b.atan().abs() <= MAX_HEADING_RAD && f.a_sd.hypot(f.b_sd * f.mean_x) <= MAX_SPREAD_M;
+        let plausible =
+            |f: &Fit| f.b.atan().abs() <= MAX_HEADING_RAD && f.a_sd.hypot(f.b_sd * f.mean_x) <= MAX_SPREAD_M;
         let Some(fit) = fit.filter(plausible) else { return Some(not_found) };
         // The line y = a + b x in the robot's frame, along +x: the robot's heading less the
         // line's direction is -atan b; its distance from the line, left positive, -a / |(1, b)|.
