@@ -97,7 +97,7 @@ impl StepSearch {
             self.profiles.measure(img, rect, COLUMN_STEP, darker);
             let sd = self.profiles.spread(&mut self.spread).max(MIN_SPREAD);
             let (sum, columns) = self.profiles.sum_along(line, 1);
-            let z = sum / (sd * (columns.max(1) as f32).sqrt());
+            let z = StepLine { line: *line, sum, columns }.z(sd);
             z >= MIN_Z && self.profiles.support(line, SUPPORT_BAND_ROWS, sd) >= MIN_SUPPORT
         })
     }
