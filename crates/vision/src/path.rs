@@ -159,7 +159,8 @@ impl PathTracker {
     }
 
     /// Update with a frame's lines: group against the prediction; if not confident, once more
-    /// with doubled tolerances; a confident fit becomes the next prediction. `None`: lost.
+    /// with doubled tolerances; a confident fit that follows from the prediction (`follows`)
+    /// becomes the next prediction. `None`: lost.
     pub fn update(&mut self, lines: &[Line]) -> Option<PathFit> {
         let p = self.params;
         let wide = PathParams { max_distance_px: 2.0 * p.max_distance_px, max_angle: 2.0 * p.max_angle, ..p };
@@ -167,11 +168,26 @@ impl PathTracker {
         // the path ahead (taken as the next prediction, it would shut every fragment out).
         let lowest = (self.horizon_v + self.bottom_v) / 2.0;
         let fit = [p, wide].into_iter().find_map(|q| {
-            group(lines, &self.left, &self.right, self.horizon_v, self.bottom_v, &q)
-                .filter(|f| f.confidence >= p.min_confidence && f.vanishing[1] < lowest)
+            group(lines, &self.left, &self.right, self.horizon_v, self.bottom_v, &q).filter(|f| {
+                f.confidence >= p.min_confidence && f.vanishing[1] < lowest && self.follows(f, &q)
+            })
         })?;
         // The vanishing point bounds the fragments of the next frame.
         (self.left, self.right, self.horizon_v) = (fit.left, fit.right, fit.vanishing[1]);
         Some(fit)
+    }
+
+    /// Whether `fit` follows from the prediction within the tolerances `q`: each edge of like
+    /// direction (the fragments' principal axis can turn far from every fragment's own, when
+    /// they scatter), and the vanishing row moved no further than an edge may (ground lines
+    /// vanish on the horizon, which moves only as the camera pitches).
+    pub fn follows(&self, fit: &PathFit, q: &PathParams) -> bool {
+        let turn = |a: f32, b: f32| {
+            let d = (a - b).rem_euclid(std::f32::consts::PI);
+            d.min(std::f32::consts::PI - d)
+        };
+        turn(fit.left.angle, self.left.angle) <= q.max_angle
+            && turn(fit.right.angle, self.right.angle) <= q.max_angle
+            && (fit.vanishing[1] - self.horizon_v).abs() <= q.max_distance_px
     }
 }

@@ -141,7 +141,8 @@ impl PathTracker {
     /// by its step near the prediction (within the tracker's tolerances, not widened: a faint
     /// edge's search reaches further than its fragments' grouping), the
     /// length of the columns each crosses the confidence. A fit whose edges cross below the
-    /// middle of the rows the path was last seen on is refused, as `update` refuses one. A
+    /// middle of the rows the path was last seen on, or that does not follow from the prediction
+    /// (`PathTracker::follows`), is refused, as `update` refuses one. A
     /// confident fit becomes the next prediction; `None`: lost.
     pub fn update_by_steps(
         &mut self,
@@ -155,9 +156,6 @@ impl PathTracker {
         let (l, wl) = search.edge(img, window, &self.left, rows, tolerance)?;
         let (r, wr) = search.edge(img, window, &self.right, rows, tolerance)?;
         let vanishing = l.cross(&r)?;
-        if vanishing[1] >= (self.horizon_v + self.bottom_v) / 2.0 || wl + wr < p.min_confidence {
-            return None;
-        }
         let bottom = [(l.x_at(self.bottom_v) + r.x_at(self.bottom_v)) / 2.0, self.bottom_v];
         let fit = PathFit {
             left: l,
@@ -166,6 +164,10 @@ impl PathTracker {
             vanishing,
             confidence: wl + wr,
         };
+        let low = vanishing[1] >= (self.horizon_v + self.bottom_v) / 2.0;
+        if low || wl + wr < p.min_confidence || !self.follows(&fit, &p) {
+            return None;
+        }
         (self.left, self.right, self.horizon_v) = (fit.left, fit.right, fit.vanishing[1]);
         Some(fit)
     }

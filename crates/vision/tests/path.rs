@@ -89,7 +89,7 @@ fn a_faint_path_lost_by_its_fragments_is_found_by_its_steps() {
     let (mut worst_x, mut worst_turn, mut by_fragments) = (0.0f32, 0.0f32, 0);
     for seed in 1..=6u64 {
         let mut tracker =
-            PathTracker::new(off(truth(320.0, 150.0)), off(truth(320.0, 490.0)), 240.0, 479.0, params);
+            PathTracker::new(off(truth(320.0, 150.0)), off(truth(320.0, 490.0)), 200.0, 479.0, params);
         for k in 0..4 {
             let shift = 4.0 * k as f32;
             let (vx, xl, xr) = (320.0 + shift, 150.0 + 1.5 * shift, 490.0 + 1.5 * shift);
@@ -120,10 +120,69 @@ fn a_faint_path_lost_by_its_fragments_is_found_by_its_steps() {
     assert!(by_fragments <= 12, "the fragments found {by_fragments} of 24: not a faint path");
     // The verges alone: nothing stands out, and the tracker keeps its model.
     for seed in 1..=6u64 {
-        let mut tracker = PathTracker::new(truth(320.0, 150.0), truth(320.0, 490.0), 240.0, 479.0, params);
+        let mut tracker = PathTracker::new(truth(320.0, 150.0), truth(320.0, 490.0), 200.0, 479.0, params);
         let before = tracker.clone();
         let img = faint(320.0, 150.0, 490.0, 0.0, 100 + seed);
         assert_eq!(tracker.update_by_steps(&img.view(), img.view().full(), &mut search), None, "seed {seed}");
         assert_eq!(tracker, before);
     }
+}
+
+/// A fragment of `length` px along `line`, its middle at row `y` shifted `dx` px along the row.
+fn fragment(line: &ImageLine, y: f32, dx: f32, length: f32) -> harvey_vision::flf::Line {
+    let (s, c) = line.angle.sin_cos();
+    let mid = [line.x_at(y) + dx, y];
+    let h = length / 2.0;
+    harvey_vision::flf::Line {
+        from: [mid[0] - h * c, mid[1] - h * s],
+        to: [mid[0] + h * c, mid[1] + h * s],
+        length,
+        orientation_deg: line.angle.to_degrees().rem_euclid(180.0),
+        mean_gradient: 20.0,
+        dispersion: 0.5,
+        pixels: length as u32,
+    }
+}
+
+#[test]
+fn a_fit_that_does_not_follow_from_the_prediction_is_refused() {
+    use harvey_vision::path::group;
+    let params = PathParams { max_distance_px: 15.0, max_angle: 10f32.to_radians(), min_confidence: 40.0 };
+    let (left, right) = (truth(320.0, 150.0), truth(320.0, 490.0));
+    let on_right: Vec<_> = [300.0, 360.0, 420.0].iter().map(|&y| fragment(&right, y, 0.0, 30.0)).collect();
+    let turn = |a: f32, b: f32| {
+        let d = (a - b).rem_euclid(std::f32::consts::PI);
+        d.min(std::f32::consts::PI - d).to_degrees()
+    };
+    // Short fragments along the left edge's direction, each within the tolerances of it, but
+    // stacked down one column: their ends' principal axis stands near upright (harsh seed 2's
+    // gravel, where such a fit of 80 degrees took the tracker off the path for good).
+    let x = left.x_at(420.0);
+    let mut stacked: Vec<_> =
+        [400.0, 420.0, 440.0].iter().map(|&y| fragment(&left, y, x - left.x_at(y), 8.0)).collect();
+    stacked.extend(on_right.iter().copied());
+    let fit = group(&stacked, &left, &right, 200.0, 479.0, &params).expect("grouped");
+    assert!(turn(fit.left.angle, left.angle) > 20.0, "{:?}", fit.left);
+    // Both edges vanishing 40 px higher (the camera would have pitched 4 degrees in a frame):
+    // each edge turns only some degrees.
+    let risen: Vec<_> = [150.0, 490.0]
+        .iter()
+        .flat_map(|&xb| {
+            let higher = ImageLine::through([320.0, 160.0], [xb, 480.0]);
+            [300.0, 360.0, 420.0].map(|y| fragment(&higher, y, 0.0, 30.0))
+        })
+        .collect();
+    let fit = group(&risen, &left, &right, 200.0, 479.0, &params).expect("grouped");
+    assert!(turn(fit.left.angle, left.angle) < 10.0 && (fit.vanishing[1] - 200.0).abs() > 30.0, "{fit:?}");
+    for lines in [&stacked, &risen] {
+        let mut tracker = PathTracker::new(left, right, 200.0, 479.0, params);
+        let before = tracker.clone();
+        assert_eq!(tracker.update(lines), None);
+        assert_eq!(tracker, before);
+    }
+    // The same fragments along the predicted edges are followed.
+    let mut along: Vec<_> = [300.0, 360.0, 420.0].iter().map(|&y| fragment(&left, y, 0.0, 30.0)).collect();
+    along.extend(on_right.iter().copied());
+    let fit = PathTracker::new(left, right, 200.0, 479.0, params).update(&along).expect("followed");
+    assert!((fit.vanishing[1] - 200.0).abs() < 1.0 && (fit.vanishing[0] - 320.0).abs() < 1.0, "{fit:?}");
 }
