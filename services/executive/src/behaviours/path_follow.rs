@@ -62,6 +62,8 @@ pub struct PathFollow {
     /// parameter: a new value starts the worker's tracker afresh).
     misfits: u32,
     generation: u32,
+    /// The travel when the tracker was last started afresh for want of fits.
+    restarted_at_m: f64,
     /// Fits steered by, and the last one taken to the ground.
     pub fits: u32,
     pub last: Option<Seen>,
@@ -93,6 +95,7 @@ impl PathFollow {
             blind: false,
             misfits: 0,
             generation: 0,
+            restarted_at_m: 0.0,
             fits: 0,
             last: None,
             transitions: 0,
@@ -176,10 +179,7 @@ impl PathFollow {
             self.misfits += 1;
             if self.misfits >= MISFITS {
                 self.misfits = 0;
-                self.generation += 1;
-                let at = self.believed();
-                self.request = self.bootstrap(at, r.header.stamp_ns);
-                self.standing = self.request;
+                self.restart(r.header.stamp_ns);
             }
             return;
         }
@@ -267,6 +267,18 @@ impl PathFollow {
                     self.done = Some(false);
                     return (0.0, 0.0);
                 }
+                // The tracker may hold a model the frames no longer fit (a wrong fit fed forward):
+                // without fits for a while it starts afresh from the map.
+                let unfitted = self.travelled_m - self.fitted_at_m.max(self.restarted_at_m);
+                if !self.blind && unfitted > self.g.restart_after_m {
+                    tracing::info!(
+                        segment = self.k,
+                        travelled_m = self.travelled_m,
+                        "no path fit: tracking afresh"
+                    );
+                    self.restarted_at_m = self.travelled_m;
+                    self.restart(now);
+                }
                 // Steer for the fit's point while it is ahead; else (before a segment's first fit,
                 // or fits lacking) for the map's, from where the UMS has the robot.
                 let from_fit = self.target.map(|t| self.odometry.inverse().apply(t));
@@ -284,6 +296,15 @@ impl PathFollow {
 }
 
 impl PathFollow {
+    /// Starts the workers' tracker afresh (a new generation of the standing request) from the
+    /// map's edges where the robot is believed to be.
+    fn restart(&mut self, now: u64) {
+        self.generation += 1;
+        let at = self.believed();
+        self.request = self.bootstrap(at, now);
+        self.standing = self.request;
+    }
+
     /// Keeps the window's top row nearer than the bend `remaining_m` ahead (less the margin),
     /// so that the next segment's edges do not enter it; blind once that leaves less than
     /// `least_depth_m` of the path in view. The tracker goes on from frame to frame: only the

@@ -64,3 +64,35 @@ fn a_fit_left_of_the_robot_steers_it_left_and_the_bend_turns_it_right() {
     assert!(c.linear_mps == 0.0 && c.angular_radps < 0.0, "{c:?}");
     assert_eq!(p.k, 1);
 }
+
+#[test]
+fn without_fits_the_tracker_starts_afresh_from_the_map_and_the_path_is_lost_later() {
+    let g = goal();
+    let mut p = in_world(&g, &campus()).expect("built");
+    let generation = |r: Option<VisionRequest>| r.map(|r| r.params[7]);
+    let at = |x: f64| Pose2::new(x, 0.0, 0.0);
+    let (r, _, _) = p.on_odometry(at(0.0), 1);
+    assert_eq!(generation(r), Some(0.0));
+    // Fits lacking: the same tracker (window changes aside) up to `restart_after_m`, then a new
+    // generation of the request, predicted from where the robot is believed to be.
+    let mut restarts = Vec::new();
+    for k in 1..=30u64 {
+        let x = 0.1 * k as f64;
+        let (r, c, _) = p.on_odometry(at(x), 1 + k);
+        if let Some(r) = r.filter(|r| r.params[7] > 0.0) {
+            restarts.push((x, r.params[7]));
+        }
+        if x > g.lost_after_m + 0.05 {
+            assert_eq!(p.done, Some(false), "lost at {x}");
+            assert_eq!(c.linear_mps, 0.0);
+            break;
+        }
+        assert_eq!(p.done, None, "{x}");
+    }
+    // The first request of each new generation, and the travel it came at.
+    restarts.dedup_by_key(|r| r.1);
+    assert_eq!(restarts.iter().map(|r| r.1).collect::<Vec<_>>(), [1.0, 2.0], "{restarts:?}");
+    let r = g.restart_after_m;
+    assert!(restarts[0].0 > r && restarts[0].0 < r + 0.15, "{restarts:?}");
+    assert!(restarts[1].0 > 2.0 * r && restarts[1].0 < 2.0 * r + 0.25, "{restarts:?}");
+}

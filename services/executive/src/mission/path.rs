@@ -45,8 +45,10 @@ pub struct PathGoal {
     /// A fit whose edges lie further apart on the ground than the map's width times 1 ±
     /// `width_tolerance` is not the path (a lawn's edge taken for it).
     pub width_tolerance: f64,
-    /// The path counts as lost, and the mission as failed, after this much travel without a
-    /// fit the robot could steer by (m).
+    /// Without a fit the robot could steer by for this much travel, the workers' tracker starts
+    /// afresh from the map and the UMS's pose (once per as much travel), and the path counts as
+    /// lost, and the mission as failed, after `lost_after_m` (m).
+    pub restart_after_m: f64,
     pub lost_after_m: f64,
 }
 
@@ -70,6 +72,7 @@ pub(crate) fn check_bounds(k: &KeyPath, p: &PathGoal) -> Result<(), OutOfRange> 
     check(&k.key("max_angle_deg"), p.max_angle_deg, &QUARTER_TURN)?;
     check(&k.key("min_confidence_px"), p.min_confidence_px, &PIXELS)?;
     check(&k.key("width_tolerance"), p.width_tolerance, &FRACTION)?;
+    check(&k.key("restart_after_m"), p.restart_after_m, &LENGTH)?;
     check(&k.key("lost_after_m"), p.lost_after_m, &LENGTH)
 }
 
