@@ -93,9 +93,9 @@ fn sweep(mission: &str, tag: &str, seeds: &str, conditions: &[&str]) -> Vec<(Str
     })
 }
 
-// Over seeds 1..3 of each camera the robot kept within 0.002-0.013 m of the centreline (median),
-// 0.18 m at worst, at a bend (the 3 m path leaves it 1.27 m a side); over seeds 1..10 every
-// nominal and dim run reached the end (docs/evaluation.md).
+// Over seeds 1..10 of each camera every run reached the end, 0.002-0.032 m off the centreline
+// (median) and 0.2 m at worst, at a bend (the 3 m path leaves it 1.27 m a side;
+// docs/evaluation.md).
 
 #[test]
 fn the_robot_follows_the_campus_path_through_both_bends_and_class_iii_shrinks_the_map() {
@@ -109,12 +109,10 @@ fn the_robot_follows_the_campus_path_through_both_bends_and_class_iii_shrinks_th
             misses.push(format!("{c} s{seed}: {f:?}"));
         }
     }
-    // Every nominal and dim run reaches the end; under harsh, two of the three at least (harsh
-    // seed 2 loses the path near the end of the gravel bend: 8 of 10 over seeds 1..10,
-    // docs/evaluation.md).
+    // Every run reaches the end (harsh seed 2 lost the path on the gravel bend until a fit had
+    // to follow from the prediction: docs/evaluation.md).
     let lost: Vec<String> = rows.iter().filter(|r| !r.2).map(|r| format!("{} s{}", r.0, r.1)).collect();
-    let lost_harsh = rows.iter().filter(|r| !r.2 && r.0 == "harsh").count();
-    if lost.len() > lost_harsh || lost_harsh > 1 {
+    if !lost.is_empty() {
         misses.push(format!("lost the path: {lost:?}"));
     }
     // The campus counterpart of 002 Fig. 79 vs 80: the same runs with the lampposts alone. Their
