@@ -179,8 +179,10 @@ impl PathTracker {
 
     /// Whether `fit` follows from the prediction within the tolerances `q`: each edge of like
     /// direction (the fragments' principal axis can turn far from every fragment's own, when
-    /// they scatter), and the vanishing row moved no further than an edge may (ground lines
-    /// vanish on the horizon, which moves only as the camera pitches).
+    /// they scatter), and the vanishing row within `q.max_distance_px` of the last (ground lines
+    /// vanish on the horizon, which moves only as the camera pitches: 30 px is some 3 degrees).
+    /// A tracker's first `horizon_v` must be that near the frames' horizon: the vision workers
+    /// start it at a level camera's.
     pub fn follows(&self, fit: &PathFit, q: &PathParams) -> bool {
         let turn = |a: f32, b: f32| {
             let d = (a - b).rem_euclid(std::f32::consts::PI);

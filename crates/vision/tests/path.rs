@@ -186,3 +186,34 @@ fn a_fit_that_does_not_follow_from_the_prediction_is_refused() {
     let fit = PathTracker::new(left, right, 200.0, 479.0, params).update(&along).expect("followed");
     assert!((fit.vanishing[1] - 200.0).abs() < 1.0 && (fit.vanishing[0] - 320.0).abs() < 1.0, "{fit:?}");
 }
+
+#[test]
+fn a_fit_follows_when_its_edges_turn_and_its_vanishing_row_moves_within_the_tolerances() {
+    use harvey_vision::path::PathFit;
+    let params = PathParams { max_distance_px: 30.0, max_angle: 15f32.to_radians(), min_confidence: 60.0 };
+    let (left, right) = (truth(320.0, 150.0), truth(320.0, 490.0));
+    let tracker = PathTracker::new(left, right, 200.0, 479.0, params);
+    // Both edges through `v`, the left one turned `turn` degrees about it.
+    let fit = |v: [f32; 2], turn: f32| {
+        let l =
+            ImageLine { point: v, angle: ImageLine::through(v, [150.0, 480.0]).angle + turn.to_radians() };
+        let r = ImageLine::through(v, [490.0, 480.0]);
+        PathFit {
+            left: l,
+            right: r,
+            centreline: ImageLine::through(v, [320.0, 479.0]),
+            vanishing: v,
+            confidence: 100.0,
+        }
+    };
+    assert!(tracker.follows(&fit([320.0, 200.0], 0.0), &params));
+    assert!(tracker.follows(&fit([320.0, 200.0], 14.0), &params));
+    assert!(tracker.follows(&fit([320.0, 200.0], -14.0), &params));
+    assert!(!tracker.follows(&fit([320.0, 200.0], 16.0), &params), "turned past the angle");
+    assert!(!tracker.follows(&fit([320.0, 200.0], -16.0), &params), "turned past the angle");
+    // The same direction given half a turn round.
+    assert!(tracker.follows(&fit([320.0, 200.0], 180.0), &params));
+    assert!(tracker.follows(&fit([335.0, 228.0], 0.0), &params));
+    assert!(!tracker.follows(&fit([335.0, 232.0], 0.0), &params), "the vanishing row moved 32 px");
+    assert!(!tracker.follows(&fit([320.0, 168.0], 0.0), &params), "the vanishing row moved 32 px");
+}

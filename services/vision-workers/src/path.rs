@@ -1,6 +1,7 @@
 //! The path-following request (001 §2.1, `VisionAlgorithm::Path`): the line finder's fragments in
 //! the window grouped into the path's two edges by a tracker kept per request id, bootstrapped
-//! from the request's predicted edges and fed forward from each confident fit. A fit whose edges
+//! from the request's predicted edges and fed forward from each confident fit that follows from
+//! the prediction (`PathTracker::follows`). A fit whose edges
 //! do not step in the frame (a checker's diagonals grouped on a dim, noisy day), or none, gives way
 //! to the edges' steps searched near the prediction (`harvey_vision::path_steps`).
 

@@ -18,7 +18,8 @@ use super::drive;
 use super::path_view::{Seen, Segment, View};
 use crate::mission::PathGoal;
 
-/// The path request's id (one standing request, replaced at each segment).
+/// The path request's id (one standing request, replaced at each segment and when the tracker
+/// starts afresh).
 const REQUEST_ID: u32 = 2;
 /// Odometry poses kept to place a fit where the robot was when its frame was taken (ns).
 const HISTORY_NS: u64 = 3_000_000_000;
@@ -276,7 +277,6 @@ impl PathFollow {
                         travelled_m = self.travelled_m,
                         "no path fit: tracking afresh"
                     );
-                    self.restarted_at_m = self.travelled_m;
                     self.restart(now);
                 }
                 // Steer for the fit's point while it is ahead; else (before a segment's first fit,
@@ -298,10 +298,17 @@ impl PathFollow {
 impl PathFollow {
     /// Starts the workers' tracker afresh (a new generation of the standing request) from the
     /// map's edges where the robot is believed to be.
+    /// The window keeps its top where `window_short_of_bend` has brought it (the next segment's
+    /// edges kept out of the fresh tracker's first frames).
     fn restart(&mut self, now: u64) {
         self.generation += 1;
+        self.restarted_at_m = self.travelled_m;
+        let top = self.standing.map(|r| r.window_px[1]);
         let at = self.believed();
-        self.request = self.bootstrap(at, now);
+        self.request = self.bootstrap(at, now).map(|mut r| {
+            r.window_px[1] = top.map_or(r.window_px[1], |t| t.max(r.window_px[1]));
+            r
+        });
         self.standing = self.request;
     }
 

@@ -74,25 +74,30 @@ fn without_fits_the_tracker_starts_afresh_from_the_map_and_the_path_is_lost_late
     let (r, _, _) = p.on_odometry(at(0.0), 1);
     assert_eq!(generation(r), Some(0.0));
     // Fits lacking: the same tracker (window changes aside) up to `restart_after_m`, then a new
-    // generation of the request, predicted from where the robot is believed to be.
-    let mut restarts = Vec::new();
-    for k in 1..=30u64 {
+    // generation of the request, predicted from where the robot is believed to be, its window's
+    // top where the last request had it.
+    let (mut restarts, mut top, mut lost_at) = (Vec::new(), 0.0f32, None);
+    for k in 1..=40u64 {
         let x = 0.1 * k as f64;
         let (r, c, _) = p.on_odometry(at(x), 1 + k);
-        if let Some(r) = r.filter(|r| r.params[7] > 0.0) {
-            restarts.push((x, r.params[7]));
+        if let Some(r) = r {
+            if r.params[7] > restarts.last().map_or(0.0, |r: &(f64, f32)| r.1) {
+                assert!(r.window_px[1] >= top, "the restart at {x} raised the window's top");
+                restarts.push((x, r.params[7]));
+            }
+            top = r.window_px[1];
         }
-        if x > g.lost_after_m + 0.05 {
-            assert_eq!(p.done, Some(false), "lost at {x}");
-            assert_eq!(c.linear_mps, 0.0);
+        if p.done.is_some() {
+            assert_eq!((p.done, c.linear_mps), (Some(false), 0.0));
+            lost_at = Some(x);
             break;
         }
-        assert_eq!(p.done, None, "{x}");
     }
-    // The first request of each new generation, and the travel it came at.
-    restarts.dedup_by_key(|r| r.1);
     assert_eq!(restarts.iter().map(|r| r.1).collect::<Vec<_>>(), [1.0, 2.0], "{restarts:?}");
     let r = g.restart_after_m;
     assert!(restarts[0].0 > r && restarts[0].0 < r + 0.15, "{restarts:?}");
     assert!(restarts[1].0 > 2.0 * r && restarts[1].0 < 2.0 * r + 0.25, "{restarts:?}");
+    let lost = lost_at.expect("the path is lost");
+    assert!(lost > g.lost_after_m && lost < g.lost_after_m + 0.15, "lost at {lost}");
+    assert!(top > p.rows.0 as f32, "the window was cut short by the distance to the bend: {top}");
 }
