@@ -97,8 +97,7 @@ fn edge(
     for l in lines {
         let mid = [(l.from[0] + l.to[0]) / 2.0, (l.from[1] + l.to[1]) / 2.0];
         let dir = (l.to[1] - l.from[1]).atan2(l.to[0] - l.from[0]);
-        let mut turn = (dir - predicted.angle).rem_euclid(std::f32::consts::PI);
-        turn = turn.min(std::f32::consts::PI - turn);
+        let turn = turn_between(dir, predicted.angle);
         // The ground's lateral tolerance shrinks in the image towards the vanishing point.
         let allowed = MIN_DISTANCE_PX + p.max_distance_px * ((mid[1] - horizon_v) / span).clamp(0.0, 1.0);
         if mid[1] <= horizon_v || turn > p.max_angle || predicted.distance(mid) > allowed {
@@ -164,13 +163,9 @@ impl PathTracker {
     pub fn update(&mut self, lines: &[Line]) -> Option<PathFit> {
         let p = self.params;
         let wide = PathParams { max_distance_px: 2.0 * p.max_distance_px, max_angle: 2.0 * p.max_angle, ..p };
-        // A fit whose edges cross below the middle of the rows the path was last seen on is not
-        // the path ahead (taken as the next prediction, it would shut every fragment out).
-        let lowest = (self.horizon_v + self.bottom_v) / 2.0;
         let fit = [p, wide].into_iter().find_map(|q| {
-            group(lines, &self.left, &self.right, self.horizon_v, self.bottom_v, &q).filter(|f| {
-                f.confidence >= p.min_confidence && f.vanishing[1] < lowest && self.follows(f, &q)
-            })
+            group(lines, &self.left, &self.right, self.horizon_v, self.bottom_v, &q)
+                .filter(|f| self.takes(f, &q))
         })?;
         // The vanishing point bounds the fragments of the next frame.
         (self.left, self.right, self.horizon_v) = (fit.left, fit.right, fit.vanishing[1]);
@@ -184,12 +179,22 @@ impl PathTracker {
     /// A tracker's first `horizon_v` must be that near the frames' horizon: the vision workers
     /// start it at a level camera's.
     pub fn follows(&self, fit: &PathFit, q: &PathParams) -> bool {
-        let turn = |a: f32, b: f32| {
-            let d = (a - b).rem_euclid(std::f32::consts::PI);
-            d.min(std::f32::consts::PI - d)
-        };
-        turn(fit.left.angle, self.left.angle) <= q.max_angle
-            && turn(fit.right.angle, self.right.angle) <= q.max_angle
+        turn_between(fit.left.angle, self.left.angle) <= q.max_angle
+            && turn_between(fit.right.angle, self.right.angle) <= q.max_angle
             && (fit.vanishing[1] - self.horizon_v).abs() <= q.max_distance_px
     }
+
+    /// Whether `fit` becomes the next prediction: confident, and following from this one. A fit
+    /// whose edges cross below the middle of the rows the path was last seen on is not the path
+    /// ahead either (taken as the next prediction, it would shut every fragment out).
+    pub(crate) fn takes(&self, fit: &PathFit, q: &PathParams) -> bool {
+        let lowest = (self.horizon_v + self.bottom_v) / 2.0;
+        fit.confidence >= q.min_confidence && fit.vanishing[1] < lowest && self.follows(fit, q)
+    }
+}
+
+/// The angle between two image directions, whichever way round each is given (0..=pi/2).
+pub fn turn_between(a: f32, b: f32) -> f32 {
+    let d = (a - b).rem_euclid(std::f32::consts::PI);
+    d.min(std::f32::consts::PI - d)
 }

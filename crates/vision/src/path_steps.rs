@@ -164,8 +164,7 @@ impl PathTracker {
             vanishing,
             confidence: wl + wr,
         };
-        let low = vanishing[1] >= (self.horizon_v + self.bottom_v) / 2.0;
-        if low || wl + wr < p.min_confidence || !self.follows(&fit, &p) {
+        if !self.takes(&fit, &p) {
             return None;
         }
         (self.left, self.right, self.horizon_v) = (fit.left, fit.right, fit.vanishing[1]);

@@ -34,8 +34,7 @@ fn the_path_is_followed_frame_by_frame_and_lost_when_an_edge_is_hidden() {
         let (tl, tr) = (truth(vx, xl), truth(vx, xr));
         for (got, want) in [(fit.left, tl), (fit.right, tr)] {
             assert!((got.x_at(470.0) - want.x_at(470.0)).abs() < 1.5, "frame {k}: {got:?} vs {want:?}");
-            let mut turn = (got.angle - want.angle).rem_euclid(std::f32::consts::PI);
-            turn = turn.min(std::f32::consts::PI - turn);
+            let turn = harvey_vision::path::turn_between(got.angle, want.angle);
             assert!(turn < 1f32.to_radians(), "frame {k}: {got:?} vs {want:?}");
         }
         assert!(
@@ -106,8 +105,7 @@ fn a_faint_path_lost_by_its_fragments_is_found_by_its_steps() {
             assert_eq!(checked, Some(fit), "seed {seed} frame {k}");
             for (got, want) in [(fit.left, truth(vx, xl)), (fit.right, truth(vx, xr))] {
                 worst_x = worst_x.max((got.x_at(470.0) - want.x_at(470.0)).abs());
-                let mut turn = (got.angle - want.angle).rem_euclid(std::f32::consts::PI);
-                turn = turn.min(std::f32::consts::PI - turn);
+                let turn = harvey_vision::path::turn_between(got.angle, want.angle);
                 worst_turn = worst_turn.max(turn);
             }
         }
@@ -150,10 +148,7 @@ fn a_fit_that_does_not_follow_from_the_prediction_is_refused() {
     let params = PathParams { max_distance_px: 15.0, max_angle: 10f32.to_radians(), min_confidence: 40.0 };
     let (left, right) = (truth(320.0, 150.0), truth(320.0, 490.0));
     let on_right: Vec<_> = [300.0, 360.0, 420.0].iter().map(|&y| fragment(&right, y, 0.0, 30.0)).collect();
-    let turn = |a: f32, b: f32| {
-        let d = (a - b).rem_euclid(std::f32::consts::PI);
-        d.min(std::f32::consts::PI - d).to_degrees()
-    };
+    let turn = |a: f32, b: f32| harvey_vision::path::turn_between(a, b).to_degrees();
     // Short fragments along the left edge's direction, each within the tolerances of it, but
     // stacked down one column: their ends' principal axis stands near upright (harsh seed 2's
     // gravel, where such a fit of 80 degrees took the tracker off the path for good).

@@ -63,7 +63,7 @@ pub struct PathFollow {
     /// parameter: a new value starts the worker's tracker afresh).
     misfits: u32,
     generation: u32,
-    /// The travel when the tracker was last started afresh for want of fits.
+    /// The travel when the tracker was last started afresh (fits lacking, or misfits).
     restarted_at_m: f64,
     /// Fits steered by, and the last one taken to the ground.
     pub fits: u32,
