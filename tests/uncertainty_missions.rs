@@ -5,9 +5,10 @@
 //! error model covers the sensors. Under the shipped worlds' camera and map errors the map loses
 //! the truth on some seeds (docs/evaluation.md): not yet an invariant there. With the signs
 //! ranged too (class II, `missions/uncertainty-signs.toml`) the map is smaller again, and loses
-//! the truth no more often than with the bearings alone (ideal, nominal, dim; not harsh, whose
-//! mount is three times worse than the robot's survey says: docs/evaluation.md); with the
-//! baseboard too (class III, `missions/uncertainty-all-classes.toml`) smaller again, likewise.
+//! the truth no more often than with the bearings alone (ideal, nominal, dim, and harsh, whose
+//! mount is three times worse than the robot's survey says, now that the UMS measures it at the
+//! start: docs/evaluation.md); with the baseboard too (class III,
+//! `missions/uncertainty-all-classes.toml`) smaller again, likewise.
 #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
 
 mod common;
@@ -89,7 +90,11 @@ fn landmarks_keep_the_map_several_times_smaller_than_dead_reckoning() {
 #[test]
 fn each_class_of_landmark_added_keeps_the_map_smaller_and_loses_the_truth_no_more_often() {
     let missions = ["uncertainty", "uncertainty-signs", "uncertainty-all-classes"];
-    for (condition, seeds) in [("ideal", 1..=3), ("nominal", 1..=6), ("dim", 1..=3)] {
+    // Under harsh the map need not end smaller: the bearings alone may shrink a map that has lost
+    // the truth (seed 4: 7 maps without it, the signs' 0 a few % larger on average).
+    let conditions =
+        [("ideal", 1..=3, true), ("nominal", 1..=6, true), ("dim", 1..=3, true), ("harsh", 1..=5, false)];
+    for (condition, seeds, smaller) in conditions {
         for seed in seeds {
             let runs: Vec<Maps> = missions
                 .iter()
@@ -121,7 +126,7 @@ fn each_class_of_landmark_added_keeps_the_map_smaller_and_loses_the_truth_no_mor
                 all.lines
             );
             assert!(
-                mean(signs) < mean(bearings) && mean(all) < mean(signs),
+                !smaller || (mean(signs) < mean(bearings) && mean(all) < mean(signs)),
                 "{condition} s{seed}: not smaller"
             );
             for r in [signs, all] {

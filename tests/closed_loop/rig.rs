@@ -135,6 +135,7 @@ impl Rig {
             image_px,
             fix_m: 0.05,
             fix_heading_rad: 0.5f64.to_radians(),
+            mount_gate: None,
         };
         let exec =
             harvey_executive::setup::load(&l.file, Some(&l.world), l.seed).expect("the mission").executive;

@@ -3,7 +3,8 @@
 //! stamps — a late sighting is applied to the map as it was then and the growth since replayed —
 //! the Expecter publishes where each active landmark must appear (§4, §5.1), the executive's pose
 //! fixes (000 §5.6) shrink it to a small region, and the map reports "lost" when it grows too
-//! large or predicted landmarks go missing.
+//! large or predicted landmarks go missing. Optionally the camera mount is measured from the
+//! sightings at the start and taken off every sighting (`mount.rs`).
 
 mod consensus;
 mod error;
@@ -11,6 +12,7 @@ pub mod expecter;
 mod fix;
 pub mod geometry;
 pub mod map;
+pub mod mount;
 pub mod node;
 pub mod reduction;
 pub mod resume;
@@ -43,6 +45,9 @@ pub struct Config {
     /// round the fixed position (m), and the heading either way (rad).
     pub fix_m: f64,
     pub fix_heading_rad: f64,
+    /// Measure the camera mount from the sightings at the start and take it off every sighting
+    /// (`mount.rs`); `None` takes the sightings as the vision workers give them.
+    pub mount_gate: Option<mount::Gate>,
 }
 
 /// Pixels added around a window for the strategy that searches it: a correlation template's
@@ -90,6 +95,8 @@ pub struct Ums {
     seq: u64,
     /// Each expectation's own sequence number (several go out per map, or none).
     expectation_seq: u64,
+    /// The camera mount measured at the start.
+    mount: mount::Mount,
 }
 
 impl Ums {
@@ -111,6 +118,7 @@ impl Ums {
             missed: 0,
             seq: 0,
             expectation_seq: 0,
+            mount: mount::Mount::default(),
         }
     }
 
@@ -169,6 +177,8 @@ impl Ums {
         self.pending.retain(|s| s.header.stamp_ns > o.header.stamp_ns);
         let mut rejected: Vec<Output> = Vec::new();
         for frame in due.chunk_by(|a, b| a.header.stamp_ns == b.header.stamp_ns) {
+            let frame: Vec<LandmarkSighting> = frame.iter().map(|s| self.calibrated(s)).collect();
+            let frame = frame.as_slice();
             let blunders = consensus::outliers(&self.world, &self.map, frame, self.config.sigmas);
             for (i, s) in frame.iter().enumerate() {
                 let why = if blunders.contains(&i) {
@@ -205,7 +215,8 @@ impl Ums {
             self.pending.push(*s);
             return Ok(());
         }
-        self.apply_sighting(s)
+        let s = self.calibrated(s);
+        self.apply_sighting(&s)
     }
 
     fn check_sighting(&self, s: &LandmarkSighting) -> Result<(), SightingError> {

@@ -35,6 +35,10 @@ pub struct Args {
     /// How late a sighting may arrive and still be applied at its own stamp.
     #[arg(long, default_value_t = 2000)]
     pub history_ms: u64,
+    /// Measure the camera mount's yaw and pitch from the sightings at the start, where the map
+    /// still pins the pose, and take them off every sighting (`mount.rs`).
+    #[arg(long, default_value_t = false, action = clap::ArgAction::Set)]
+    pub calibrate_mount: bool,
     /// A refusal repeated (the same landmark, the same reason) is logged at most once in this
     /// many seconds of message time, with its count.
     #[arg(long, default_value_t = 5.0)]
@@ -144,6 +148,12 @@ pub fn build(args: Args, p: &mut Ports) -> anyhow::Result<UmsNode> {
         image_px,
         fix_m: args.fix_m,
         fix_heading_rad: args.fix_heading_deg.to_radians(),
+        // At the start, while the map knows the heading as well as the survey knows the mount,
+        // and the position as well as it knows the map.
+        mount_gate: args.calibrate_mount.then(|| crate::mount::Gate {
+            heading_rad: world.survey.calibration_sd_rad,
+            area_m2: world.survey.position_sd_m.powi(2),
+        }),
     };
     let odometry = p.input(topics::ODOMETRY);
     // In real time a turn is as late as the newest of these.

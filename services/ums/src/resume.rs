@@ -24,6 +24,7 @@ pub struct UmsState {
     missed: u32,
     seq: u64,
     expectation_seq: u64,
+    mount: crate::mount::Mount,
 }
 
 impl PartialEq for Step {
@@ -47,6 +48,7 @@ impl Ums {
             missed: self.missed,
             seq: self.seq,
             expectation_seq: self.expectation_seq,
+            mount: self.mount.clone(),
         }
     }
 
@@ -55,6 +57,6 @@ impl Ums {
         (self.map, self.history, self.pending) = (s.map, s.history, s.pending);
         (self.command_id, self.travelled_m, self.turned_rad) = (s.command_id, s.travelled_m, s.turned_rad);
         (self.run_started, self.last_stamp_ns, self.missed) = (s.run_started, s.last_stamp_ns, s.missed);
-        (self.seq, self.expectation_seq) = (s.seq, s.expectation_seq);
+        (self.seq, self.expectation_seq, self.mount) = (s.seq, s.expectation_seq, s.mount);
     }
 }

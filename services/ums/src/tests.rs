@@ -18,6 +18,7 @@ fn ums() -> Ums {
         image_px: (640, 480),
         fix_m: 0.05,
         fix_heading_rad: 0.01,
+        mount_gate: None,
     };
     Ums::new(hallway(), config)
 }
