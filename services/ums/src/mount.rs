@@ -6,6 +6,7 @@
 //! then taken off every later sighting, so that a mount further off than the robot's survey says
 //! does not bias every bearing and range alike, which no reduction can tell from a pose error.
 
+use harvey_geometry::median;
 use harvey_msgs::{LandmarkSighting, SightingKind};
 use harvey_world::World;
 
@@ -27,17 +28,6 @@ pub struct Gate {
     pub area_m2: f64,
 }
 
-/// The median of `v`, zero when empty.
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    match s.len() {
-        0 => 0.0,
-        n if n % 2 == 1 => s[n / 2],
-        n => 0.5 * (s[n / 2 - 1] + s[n / 2]),
-    }
-}
-
 /// The point's elevation above the camera's level, seen `depth_m` ahead (`above_m` above it).
 fn elevation(above_m: f64, depth_m: f64) -> f64 {
     (above_m / depth_m).atan()
@@ -46,7 +36,7 @@ fn elevation(above_m: f64, depth_m: f64) -> f64 {
 impl Mount {
     /// The yaw and pitch measured so far (zero where nothing measured them).
     pub fn estimate(&self) -> (f64, f64) {
-        (median(&self.yaws), median(&self.pitches))
+        (median(&self.yaws).unwrap_or(0.0), median(&self.pitches).unwrap_or(0.0))
     }
 
     /// How many sightings have measured the yaw and the pitch.
