@@ -22,6 +22,7 @@ pub mod drive;
 pub mod fsa;
 pub mod grid_plan;
 pub mod neptune;
+mod odo_scale;
 pub mod opening;
 pub mod path_follow;
 pub mod path_view;

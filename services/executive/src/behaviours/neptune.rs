@@ -1,7 +1,8 @@
 //! CMU's stop-go-stop visual navigation (003, Neptune): at each stop the robot stands still and
 //! looks (a stereo odometry request, the motion since the last look predicted by the encoders as
 //! the paper's planner predicted it); the position model moves by the motion stereo solved (by
-//! the prediction when it solved none: a stop counted unsolved), the obstacle points join the
+//! the prediction when it solved none: a stop counted unsolved, the encoders' run scaled by what
+//! the solved steps measured of them, `odo_scale.rs`), the obstacle points join the
 //! map, a path is planned round them to the goal, and the robot goes a step along it: turns
 //! towards the step's end, drives to it by the encoders, and stops to look again.
 
@@ -13,6 +14,7 @@ use harvey_msgs::{
 
 use super::drive;
 use super::grid_plan::{Grid, along, kept_or_fresh};
+use super::odo_scale::OdoScale;
 use crate::mission::NeptuneGoal;
 
 /// The odometry request's id: the vision workers keep one odometry per id.
@@ -64,6 +66,8 @@ pub struct Neptune {
     obstacles: Vec<([f64; 2], [f64; 2])>,
     /// The path the last step was taken along (world frame, the goal last).
     route: Vec<[f64; 2]>,
+    /// The encoders' distance scale the solved steps measure.
+    scale: OdoScale,
     /// Looks answered, and those whose motion came from the prediction.
     pub stops: u32,
     pub unsolved: u32,
@@ -83,6 +87,7 @@ impl Neptune {
             ring: None,
             obstacles: Vec::new(),
             route: Vec::new(),
+            scale: OdoScale::default(),
             stops: 0,
             unsolved: 0,
             next_id: 1,
@@ -98,7 +103,7 @@ impl Neptune {
     /// The position model carried on by the encoders since the last look.
     pub fn believed(&self) -> Pose2 {
         match self.looked_at {
-            Some(l) => self.model.compose(&l.relative(&self.at)),
+            Some(l) => self.model.compose(&self.scale.apply(l.relative(&self.at))),
             None => self.model,
         }
     }
@@ -112,24 +117,28 @@ impl Neptune {
         if r.request_id != REQUEST_ID || !matches!(self.phase, Phase::Looking { .. }) {
             return;
         }
-        let predicted = self.looked_at.map(|l| l.relative(&self.at));
+        let encoders = self.looked_at.map(|l| l.relative(&self.at));
         let items = &r.items[..(r.count as usize).min(r.items.len())];
         let status = VisionStatus::from_raw(r.status);
         // Solved: the motion; else (none solved, or a worker that started afresh) the prediction.
         let solved = status == Some(VisionStatus::Found) && items.len() >= 2 && items[1].values[2] > 0.0;
-        let motion = match (solved, predicted) {
+        let motion = match (solved, encoders) {
             (true, _) => {
                 let [dx, dy, dh, ..] = items[0].values.map(f64::from);
-                Some(Pose2 { x_m: dx, y_m: dy, heading_rad: dh })
+                let m = Pose2 { x_m: dx, y_m: dy, heading_rad: dh };
+                if let Some(e) = encoders {
+                    self.scale.learn(e, m);
+                }
+                Some(m)
             }
-            (false, Some(p)) => {
+            (false, Some(e)) => {
                 self.unsolved += 1;
                 tracing::warn!(
                     stop = self.stops,
                     ?status,
                     "no motion from stereo: the stop is dead reckoned"
                 );
-                Some(p)
+                Some(self.scale.apply(e))
             }
             (false, None) => None,
         };
@@ -164,9 +173,10 @@ impl Neptune {
             let towards = self.model.heading_rad + widest.copysign(e);
             ([here[0] + towards.cos(), here[1] + towards.sin()], false)
         };
-        // The step's end in the encoders' frame, where the robot drives by them.
-        let odo_from_world = self.at.compose(&self.model.inverse());
-        self.phase = Phase::Turning { to: odo_from_world.apply(target), deadline_ns: 0, then_move };
+        // The step's end in the encoders' frame, where the robot drives by them: ahead of the
+        // model as far as ahead of the encoders' pose.
+        let ahead = self.model.inverse().apply(target);
+        self.phase = Phase::Turning { to: self.at.apply(ahead), deadline_ns: 0, then_move };
     }
 
     /// The end of the next step: `step_m` along the cheapest path round the obstacles (or the
