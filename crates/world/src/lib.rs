@@ -7,6 +7,7 @@ mod bounds;
 mod bounds_topology;
 mod camera;
 mod check;
+mod ground_line;
 mod load;
 mod model;
 mod movers;

@@ -19,6 +19,10 @@ pub struct Mount {
     pitches: Vec<f64>,
 }
 
+/// A yaw or pitch measured past this (rad) is a false match, not the mount: the world's bound on
+/// a mount's error, a camera knocked off its mount (`harvey_world` bounds).
+const MAX_MOUNT_RAD: f64 = 0.2;
+
 /// When a sighting measures the mount: the map's area within `area_m2` (the position known to
 /// the survey's map error), and for the yaw its heading wedge within `heading_rad` too (the
 /// survey's calibration: the heading is then known better than the mount).
@@ -57,14 +61,21 @@ impl Mount {
         // The heading turns the bearings as the yaw does: only while it is known better.
         if map.cw_rad + map.ccw_rad <= gate.heading_rad {
             // A mount turned left sees everything further right: at a smaller bearing.
-            self.yaws.push(wrap(bearing - s.a));
+            let yaw = wrap(bearing - s.a);
+            if yaw.abs() <= MAX_MOUNT_RAD {
+                self.yaws.push(yaw);
+            }
         }
         let above_m = l.position_m[2] - world.camera.height_m;
-        if kind == Some(SightingKind::BearingRange) && s.b > 0.0 && above_m != 0.0 {
-            let depth = dx.hypot(dy) * bearing.cos();
+        // Along the camera's axis (the worker ranges by it), the camera turned by the mount.
+        let depth = dx.hypot(dy) * s.a.cos();
+        if kind == Some(SightingKind::BearingRange) && s.b > 0.0 && above_m != 0.0 && depth > 0.0 {
             // A mount pitched down lifts everything in the image: the row reads a point above
             // the camera as higher, so nearer, than it is.
-            self.pitches.push(elevation(above_m, s.b * s.a.cos()) - elevation(above_m, depth));
+            let pitch = elevation(above_m, s.b * s.a.cos()) - elevation(above_m, depth);
+            if pitch.abs() <= MAX_MOUNT_RAD {
+                self.pitches.push(pitch);
+            }
         }
     }
 
@@ -83,18 +94,22 @@ impl Mount {
                     .get(s.landmark_index as usize)
                     .map_or(0.0, |l| l.position_m[2] - world.camera.height_m);
                 let e = elevation(above_m, s.b * s.a.cos()) - pitch;
-                // Only where the pitch leaves the point on its side of the horizon.
                 if above_m != 0.0 && s.b > 0.0 && e * above_m.signum() > 1e-4 {
+                    // The depth along the camera's axis, and the range by the camera's bearing.
                     let depth = above_m / e.tan();
-                    c.b = depth / c.a.cos();
+                    c.b = depth / s.a.cos();
                     c.b_sd = s.b_sd * c.b / s.b;
+                } else if pitch != 0.0 {
+                    // The pitch leaves the point on the horizon or past it: its row gives no
+                    // range, only its column a bearing.
+                    (c.kind, c.b, c.b_sd) = (SightingKind::Bearing as u32, 0.0, 0.0);
                 }
             }
             Some(SightingKind::GroundLine) => {
-                let below_m = world
-                    .landmarks
-                    .get(s.landmark_index as usize)
-                    .map_or(0.0, |l| world.camera.height_m - l.position_m[2]);
+                // The edge the worker ranges: a baseboard's top, or the floor.
+                let below_m = world.landmarks.get(s.landmark_index as usize).map_or(0.0, |l| {
+                    world.camera.height_m - world.wall_band(l).map_or(l.position_m[2], |(_, r)| r.height_m[1])
+                });
                 (c.a, c.b) = untilted_line(world, below_m, pitch, (s.a, s.b));
                 // The line's direction turns with the camera; its distance from it does not.
                 c.a -= yaw;
@@ -138,10 +153,11 @@ impl crate::Ums {
     /// stamp allows (`mount.rs`); as it is when the UMS does not measure the mount.
     pub(crate) fn calibrated(&mut self, s: &LandmarkSighting) -> LandmarkSighting {
         let Some(gate) = self.config.mount_gate else { return *s };
-        let i = self.history.iter().rposition(|(t, ..)| *t <= s.header.stamp_ns);
-        let map = i.map_or(&self.map, |i| &self.history[i].1);
         let before = self.mount.measures();
-        self.mount.observe(&self.world, map, gate, s);
+        // Only against the map at its stamp (one older than the history is refused anyway).
+        if let Some(i) = self.history.iter().rposition(|(t, ..)| *t <= s.header.stamp_ns) {
+            self.mount.observe(&self.world, &self.history[i].1, gate, s);
+        }
         if self.mount.measures() != before {
             let ((yaw, pitch), (yaws, pitches)) = (self.mount.estimate(), self.mount.measures());
             let landmark = &self.world.landmarks[s.landmark_index as usize].name;

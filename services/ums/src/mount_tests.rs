@@ -26,8 +26,9 @@ fn seen(
     let (dx, dy) = (l.position_m[0] - map.centre[0], l.position_m[1] - map.centre[1]);
     let bearing = dy.atan2(dx) - map.heading_rad;
     let above = l.position_m[2] - w.camera.height_m;
-    let depth = dx.hypot(dy) * bearing.cos();
     let seen_bearing = bearing - yaw;
+    // The worker ranges along the camera's axis, turned by the mount, and back by its bearing.
+    let depth = dx.hypot(dy) * seen_bearing.cos();
     let row = ((above / depth).atan() + pitch).tan();
     LandmarkSighting {
         header: Header::new(1, 0),
@@ -125,4 +126,34 @@ fn a_ground_line_seen_through_a_pitched_camera_is_taken_back_to_the_level_one() 
         assert!((h - heading).abs() < 5e-4 && (o - offset).abs() < 0.002, "{pitch}: {h} {o}");
     }
     assert_eq!(untilted_line(&w, below, 0.0, (heading, offset)), (heading, offset));
+}
+
+#[test]
+fn a_baseboard_is_untilted_at_its_top_and_a_sign_pitched_past_the_horizon_keeps_its_bearing_only() {
+    let w = hallway();
+    let (i, board) =
+        w.landmarks.iter().enumerate().find(|(_, l)| l.name == "north-baseboard").expect("board");
+    let top = w.wall_band(board).map(|(_, r)| r.height_m[1]).expect("a baseboard");
+    assert!(top > 0.05, "the band's top, not the floor: {top}");
+    let pitched = Mount { yaws: Vec::new(), pitches: vec![0.01] };
+    let line = LandmarkSighting {
+        landmark_index: i as u32,
+        kind: SightingKind::GroundLine as u32,
+        a: 0.03,
+        b: 1.2,
+        ..Default::default()
+    };
+    let c = pitched.correct(&w, &line);
+    assert_eq!((c.a, c.b), untilted_line(&w, w.camera.height_m - top, 0.01, (0.03, 1.2)));
+    let sign = w.landmarks.iter().position(|l| l.position_m[2] > w.camera.height_m + 0.5).expect("a sign");
+    let far = LandmarkSighting {
+        landmark_index: sign as u32,
+        kind: SightingKind::BearingRange as u32,
+        a: 0.01,
+        b: 40.0,
+        b_sd: 5.0,
+        ..Default::default()
+    };
+    let c = Mount { yaws: Vec::new(), pitches: vec![0.2] }.correct(&w, &far);
+    assert_eq!((c.kind, c.a), (SightingKind::Bearing as u32, 0.01), "no range from a row past the horizon");
 }

@@ -48,26 +48,11 @@ impl Band {
                 let (LandmarkClass::III, Some(to)) = (l.class, l.to_m) else { return None };
                 let a = l.position_m;
                 let height_sd_m = world.survey.position_sd_m.max(l.position_sd_m);
-                let on_wall = world.walls.iter().find_map(|w| {
-                    let len = w.length_m();
-                    let along = |p: [f64; 3]| w.local([p[0], p[1]]).0;
-                    let on = |p: [f64; 3]| w.local([p[0], p[1]]).1.abs() < 0.02;
-                    // A wall on the line (a line past doorways runs along several), overlapping it.
-                    let (lo, hi) = (along(a).min(along(to)), along(a).max(along(to)));
-                    if !(on(a) && on(to)) || hi <= 0.0 || lo >= len {
-                        return None;
-                    }
-                    // Its lowest band standing on the floor, below the camera.
-                    let r = w
-                        .regions
-                        .iter()
-                        .filter(|r| r.height_m[0] <= 0.0 && r.height_m[1] < world.camera.height_m)
-                        .min_by(|p, q| p.height_m[1].total_cmp(&q.height_m[1]))?;
-                    Some(Band {
-                        below_camera_m: world.camera.height_m - r.height_m[1],
-                        edge: Edge::Baseboard { darker: r.reflectance < w.reflectance },
-                        height_sd_m,
-                    })
+                // Along a wall's foot: its lowest band standing on the floor, below the camera.
+                let on_wall = world.wall_band(l).map(|(w, r)| Band {
+                    below_camera_m: world.camera.height_m - r.height_m[1],
+                    edge: Edge::Baseboard { darker: r.reflectance < w.reflectance },
+                    height_sd_m,
                 });
                 on_wall.or_else(|| floor_edge(world, [a[0], a[1]], [to[0], to[1]], height_sd_m))
             })
