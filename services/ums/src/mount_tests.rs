@@ -157,3 +157,59 @@ fn a_baseboard_is_untilted_at_its_top_and_a_sign_pitched_past_the_horizon_keeps_
     let c = Mount { yaws: Vec::new(), pitches: vec![0.2] }.correct(&w, &far);
     assert_eq!((c.kind, c.a), (SightingKind::Bearing as u32, 0.01), "no range from a row past the horizon");
 }
+
+#[test]
+fn a_ums_measuring_the_mount_takes_it_from_a_sighting_at_the_start_and_keeps_it_in_its_state() {
+    use harvey_msgs::{CommandKind, MotionCommand, Odometry};
+    let config = |mount_gate| crate::Config {
+        sigmas: 3.0,
+        lost_area_m2: 0.05,
+        lost_after_misses: 2,
+        history_ns: 2_000_000_000,
+        image_px: (640, 480),
+        fix_m: 0.05,
+        fix_heading_rad: 0.01,
+        mount_gate,
+    };
+    let w = hallway();
+    let mut u = crate::Ums::new(w.clone(), config(Some(GATE)));
+    let command = MotionCommand {
+        kind: CommandKind::Move as u32,
+        distance_m: 5.0,
+        command_id: 1,
+        ..Default::default()
+    };
+    let odo = |ms: u64, m: f64| Odometry {
+        header: Header::new(ms, ms * 1_000_000),
+        travelled_m: m,
+        command,
+        command_accepted: 1,
+        moving: 1,
+        ..Default::default()
+    };
+    u.on_odometry(&odo(50, 0.0)).expect("ok");
+    let start = Map::exact(w.start.x_m, w.start.y_m, w.start.heading_rad);
+    let corner = w.landmarks.iter().position(|l| l.name == "end-wall-corner").expect("corner");
+    let mut s = seen(&w, &start, corner, SightingKind::Bearing, 0.008, 0.0);
+    s.header = Header::new(1, 50_000_000);
+    // Measured whether or not the reduction takes it (the start's map is a point).
+    let _ = u.on_sighting(&s);
+    assert!((u.mount.estimate().0 - 0.008).abs() < 1e-9, "{:?}", u.mount.estimate());
+    // The measure travels in the checkpoint's state.
+    let mut v = crate::Ums::new(w.clone(), config(Some(GATE)));
+    v.restore(u.state());
+    assert_eq!(v.mount, u.mount);
+    // Further on, with the map's wedge wider than the survey's mount, nothing more is measured.
+    for k in 2..=20 {
+        u.on_odometry(&odo(k * 50, k as f64 * 0.1)).expect("ok");
+    }
+    let mut later = seen(&w, &start, corner, SightingKind::Bearing, 0.05, 0.0);
+    later.header = Header::new(2, 1_000_000_000);
+    let _ = u.on_sighting(&later);
+    assert_eq!(u.mount.measures(), (1, 0));
+    // A UMS told not to measure takes the sightings as they come.
+    let mut off = crate::Ums::new(w, config(None));
+    off.on_odometry(&odo(50, 0.0)).expect("ok");
+    let _ = off.on_sighting(&s);
+    assert_eq!(off.mount.measures(), (0, 0));
+}
