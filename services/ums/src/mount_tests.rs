@@ -6,9 +6,7 @@ use harvey_msgs::{Header, LandmarkSighting, SightingKind};
 use super::{Gate, Mount, untilted_line};
 use crate::map::Map;
 
-fn hallway() -> harvey_world::World {
-    harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway")
-}
+use crate::tests::{config, hallway, odo};
 
 const GATE: Gate = Gate { heading_rad: 0.003, area_m2: 1e-4 };
 
@@ -160,33 +158,8 @@ fn a_baseboard_is_untilted_at_its_top_and_a_sign_pitched_past_the_horizon_keeps_
 
 #[test]
 fn a_ums_measuring_the_mount_takes_it_from_a_sighting_at_the_start_and_keeps_it_in_its_state() {
-    use harvey_msgs::{CommandKind, MotionCommand, Odometry};
-    let config = |mount_gate| crate::Config {
-        sigmas: 3.0,
-        lost_area_m2: 0.05,
-        lost_after_misses: 2,
-        history_ns: 2_000_000_000,
-        image_px: (640, 480),
-        fix_m: 0.05,
-        fix_heading_rad: 0.01,
-        mount_gate,
-    };
     let w = hallway();
     let mut u = crate::Ums::new(w.clone(), config(Some(GATE)));
-    let command = MotionCommand {
-        kind: CommandKind::Move as u32,
-        distance_m: 5.0,
-        command_id: 1,
-        ..Default::default()
-    };
-    let odo = |ms: u64, m: f64| Odometry {
-        header: Header::new(ms, ms * 1_000_000),
-        travelled_m: m,
-        command,
-        command_accepted: 1,
-        moving: 1,
-        ..Default::default()
-    };
     u.on_odometry(&odo(50, 0.0)).expect("ok");
     let start = Map::exact(w.start.x_m, w.start.y_m, w.start.heading_rad);
     let corner = w.landmarks.iter().position(|l| l.name == "end-wall-corner").expect("corner");

@@ -5,12 +5,13 @@ use harvey_msgs::{CommandKind, Header, LandmarkSighting, MotionCommand, Odometry
 
 use crate::{Config, Output, Ums};
 
-fn hallway() -> harvey_world::World {
+pub(crate) fn hallway() -> harvey_world::World {
     harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway")
 }
 
-fn ums() -> Ums {
-    let config = Config {
+/// The tests' configuration, measuring the mount through `mount_gate` or not.
+pub(crate) fn config(mount_gate: Option<crate::mount::Gate>) -> Config {
+    Config {
         sigmas: 3.0,
         lost_area_m2: 0.05,
         lost_after_misses: 2,
@@ -18,12 +19,15 @@ fn ums() -> Ums {
         image_px: (640, 480),
         fix_m: 0.05,
         fix_heading_rad: 0.01,
-        mount_gate: None,
-    };
-    Ums::new(hallway(), config)
+        mount_gate,
+    }
 }
 
-fn odo(stamp_ms: u64, travelled_m: f64) -> Odometry {
+fn ums() -> Ums {
+    Ums::new(hallway(), config(None))
+}
+
+pub(crate) fn odo(stamp_ms: u64, travelled_m: f64) -> Odometry {
     let command = MotionCommand {
         kind: CommandKind::Move as u32,
         distance_m: 5.0,
