@@ -154,13 +154,20 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<i32> {
     let mut order = Vec::new();
     let ending = runner::run_all(&exe, jobs, max, &out, &interrupt, |d| {
         let row = finish(d, &cond_names, figure, args.keep);
+        // A run that ended without a status most often never started (a mission or world file
+        // it could not read): its own error says why.
+        let why = match row.figures {
+            None if !row.succeeded() => last_error(&row.log).map(|e| format!(" ({e})")),
+            _ => None,
+        };
         say(format!(
-            "  {} s{}: {}, {}: {}",
+            "  {} s{}: {}, {}: {}{}",
             row.condition,
             row.seed,
             row.outcome(),
             figure.label(),
-            row.figure.map_or("-".into(), |v| format!("{v:.2}"))
+            row.figure.map_or("-".into(), |v| format!("{v:.2}")),
+            why.unwrap_or_default()
         ));
         let key = (cond_names.iter().position(|n| *n == row.condition), row.seed);
         let at = order.partition_point(|k| *k < key);
@@ -217,6 +224,13 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<i32> {
     Ok(if rows.iter().all(Row::succeeded) { 0 } else { 1 })
 }
 
+/// The last line of a run's log that reports an error (`harvey: error: ...`), if any.
+fn last_error(log: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(log).ok()?;
+    let line = text.lines().rev().find(|l| l.contains("error:"))?;
+    Some(line.trim().chars().take(300).collect())
+}
+
 /// A finished run's row: its figures read back from its recording, which is deleted when the
 /// run succeeded (unless `keep`).
 fn finish(d: runner::Done, conditions: &[String], figure: Figure, keep: bool) -> Row {
@@ -248,4 +262,24 @@ fn finish(d: runner::Done, conditions: &[String], figure: Figure, keep: bool) ->
         row.recording = None;
     }
     row
+}
+
+#[cfg(test)]
+mod tests {
+    #![allow(clippy::unwrap_used, clippy::expect_used, reason = "test code")]
+    use super::*;
+
+    #[test]
+    fn a_run_s_last_error_line_is_what_the_sweep_names() {
+        let dir = std::env::temp_dir().join(format!("harvey-sweep-last-error-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).expect("a directory");
+        let log = dir.join("harvey-run.log");
+        let text = "INFO camera mount misaligned\nharvey: error: first\nINFO more\nharvey: error: a.toml: key `x`: unknown field\n";
+        std::fs::write(&log, text).expect("written");
+        assert_eq!(last_error(&log).as_deref(), Some("harvey: error: a.toml: key `x`: unknown field"));
+        std::fs::write(&log, "INFO all well\n").expect("written");
+        assert_eq!(last_error(&log), None);
+        assert_eq!(last_error(&dir.join("missing.log")), None);
+        std::fs::remove_dir_all(&dir).expect("removed");
+    }
 }
