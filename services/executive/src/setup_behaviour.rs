@@ -9,7 +9,7 @@ use crate::behaviours::depth_obstacles::DepthObstacles;
 use crate::behaviours::docking::Docking;
 use crate::behaviours::door_finding::DoorFinding;
 use crate::behaviours::fsa::Fsa;
-use crate::behaviours::neptune::Neptune;
+use crate::behaviours::neptune::{Neptune, Sonar};
 use crate::behaviours::path_follow;
 use crate::behaviours::pole_hunt::PoleHunt;
 
@@ -50,13 +50,17 @@ impl Site<'_> {
     }
 
     /// The docking behaviour or the pole hunt (the acceptor, the camera, the sonar, the seed),
-    /// CMU's navigation (its start), door finding (the sonar ring's radius, the start), path
+    /// CMU's navigation (its start, the sonar ring's radius), door finding (the sonar ring's radius, the start), path
     /// following (the path's edges, the camera), or depth from motion (the camera).
     pub(super) fn behaviour(&self, seed: u64) -> Result<Option<Behaviour>, SetupError> {
         let m = self.mission;
         if let Some(g) = &m.neptune {
-            let start = self.world("[mission.neptune]")?.start;
-            return Ok(Some(Behaviour::Neptune(Box::new(Neptune::new(g.clone(), start)))));
+            let w = self.world("[mission.neptune]")?;
+            let r = &w.robot;
+            let sonar =
+                Sonar { ring_m: r.sonar_ring_radius_m, beam_rad: r.sonar_beam_width_deg.to_radians() };
+            let n = Neptune::new(g.clone(), w.start, sonar);
+            return Ok(Some(Behaviour::Neptune(Box::new(n))));
         }
         if let Some(g) = &m.path {
             let w = self.world("[mission.path]")?;

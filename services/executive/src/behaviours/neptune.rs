@@ -4,7 +4,9 @@
 //! the prediction when it solved none: a stop counted unsolved, the encoders' run scaled by what
 //! the solved steps measured of them, `odo_scale.rs`), the obstacle points join the
 //! map, a path is planned round them to the goal, and the robot goes a step along it: turns
-//! towards the step's end, drives to it by the encoders, and stops to look again.
+//! towards the step's end, drives to it by the encoders, and stops to look again. A step the
+//! sonar's panic-stop holds back ends there, and the echoes that held it join the map (stereo
+//! ranges nothing nearer than 003's near limit, so a corner first seen close is the sonar's).
 
 use harvey_geometry::wrap;
 use harvey_msgs::{
@@ -49,6 +51,12 @@ enum Phase {
         to: [f64; 2],
         deadline_ns: u64,
     },
+    /// Backing straight from `from` (the encoders' frame) after the panic-stop held a step back,
+    /// until `back_off_m` is behind it or the deadline.
+    Backing {
+        from: [f64; 2],
+        deadline_ns: u64,
+    },
 }
 
 /// The navigation's state.
@@ -64,6 +72,7 @@ pub struct Neptune {
     ring: Option<SonarRing>,
     /// Obstacle points seen (world frame, m), each with where it was seen from.
     obstacles: Vec<([f64; 2], [f64; 2])>,
+    sonar: Sonar,
     /// The path the last step was taken along (world frame, the goal last).
     route: Vec<[f64; 2]>,
     /// The encoders' distance scale the solved steps measure.
@@ -77,9 +86,10 @@ pub struct Neptune {
 }
 
 impl Neptune {
-    pub fn new(g: NeptuneGoal, start: Pose2) -> Self {
+    pub fn new(g: NeptuneGoal, start: Pose2, sonar: Sonar) -> Self {
         Self {
             g,
+            sonar,
             phase: Phase::Settling { since_ns: None },
             model: start,
             looked_at: None,
@@ -210,7 +220,7 @@ impl Neptune {
         now: u64,
     ) -> (Option<VisionRequest>, MotionCommand, BehaviourState) {
         self.at = at;
-        let g = &self.g;
+        let g = self.g.clone();
         let max_turn = g.max_turn_degps.to_radians();
         let mut look = None;
         let vw = match self.phase {
@@ -261,13 +271,30 @@ impl Neptune {
                     0 => now + allowance(dx.hypot(dy) / g.speed_mps),
                     d => d,
                 };
-                if dx.hypot(dy) <= g.arrive_m || ahead <= 0.0 || now >= deadline_ns {
+                let held = self.ring.is_some_and(|r| r.panic_stop != 0);
+                if held {
+                    self.map_echoes();
+                    let deadline_ns = now + allowance(g.back_off_m / g.speed_mps);
+                    self.phase = match self.room_behind() {
+                        true => Phase::Backing { from: [at.x_m, at.y_m], deadline_ns },
+                        false => Phase::Settling { since_ns: Some(now) },
+                    };
+                    (0.0, 0.0)
+                } else if dx.hypot(dy) <= g.arrive_m || ahead <= 0.0 || now >= deadline_ns {
                     self.phase = Phase::Settling { since_ns: Some(now) };
                     (0.0, 0.0)
                 } else {
                     self.phase = Phase::Moving { to, deadline_ns };
                     let e = wrap(dy.atan2(dx) - at.heading_rad);
                     (g.speed_mps.min(ahead), (g.turn_gain * e).clamp(-max_turn, max_turn))
+                }
+            }
+            Phase::Backing { from, deadline_ns } => {
+                if (at.x_m - from[0]).hypot(at.y_m - from[1]) >= g.back_off_m || now >= deadline_ns {
+                    self.phase = Phase::Settling { since_ns: Some(now) };
+                    (0.0, 0.0)
+                } else {
+                    (-g.speed_mps, 0.0)
                 }
             }
         };
@@ -280,6 +307,7 @@ impl Neptune {
             Phase::Looking { .. } => 1,
             Phase::Turning { .. } => 2,
             Phase::Moving { .. } => 3,
+            Phase::Backing { .. } => 4,
         };
         let state = BehaviourState {
             header: Header::new(self.seq, now),
@@ -313,6 +341,10 @@ impl Neptune {
         }
     }
 }
+
+#[path = "neptune_held.rs"]
+mod held;
+pub use held::Sonar;
 
 #[cfg(test)]
 #[path = "neptune_tests.rs"]

@@ -1,6 +1,7 @@
 //! The stop-go-stop navigation on made-up looks: the model moved by the solved motion, by the
 //! encoders' when none was solved, obstacles planned round, the goal reached, a stuck step given
-//! up, and a model lost outside the room failing.
+//! up, a step the panic-stop holds ending with its echoes mapped and a back-off, and a model lost
+//! outside the room failing.
 
 use super::*;
 use harvey_msgs::VisionItem;
@@ -25,11 +26,14 @@ fn goal() -> NeptuneGoal {
         arrive_m: 0.02,
         aligned_deg: 2.0,
         max_step_turn_deg: 15.0,
+        back_off_m: 0.2,
     }
 }
 
 const START: Pose2 = Pose2::new(0.8, 3.0, 0.0);
 const TICK: u64 = 50_000_000;
+/// The sonar ring: its radius (m) and a sensor's beam.
+const RING: Sonar = Sonar { ring_m: 0.23, beam_rad: 0.52 };
 
 /// Ticks at `at` until the behaviour asks to look; returns the tick it did.
 fn until_look(n: &mut Neptune, at: Pose2, mut now: u64) -> (VisionRequest, u64) {
@@ -57,7 +61,7 @@ fn answer(status: VisionStatus, motion: [f32; 3], carried: f32, points: &[[f32; 
 
 #[test]
 fn looks_move_the_model_and_steps_go_round_what_was_seen() {
-    let mut n = Neptune::new(goal(), START);
+    let mut n = Neptune::new(goal(), START, RING);
     let (first, now) = until_look(&mut n, START, 0);
     assert_eq!((first.params[0], first.algorithm), (1.0, VisionAlgorithm::StereoOdometry as u32), "starts");
     // A wall of points 1.5 m ahead across the line: the step turns off it.
@@ -89,12 +93,12 @@ fn looks_move_the_model_and_steps_go_round_what_was_seen() {
 #[test]
 fn the_goal_ends_it_a_held_step_is_given_up_and_a_walled_in_robot_fails() {
     let near = Pose2::new(7.15, 3.0, 0.0);
-    let mut n = Neptune::new(goal(), near);
+    let mut n = Neptune::new(goal(), near, RING);
     let (_, now) = until_look(&mut n, near, 0);
     n.on_vision(&answer(VisionStatus::Found, [0.0; 3], 0.0, &[]));
     assert_eq!(n.done, Some(true), "within 10 cm of the goal");
     // A step the robot cannot make (a reflex holds it): given up, and it looks again.
-    let mut n = Neptune::new(goal(), START);
+    let mut n = Neptune::new(goal(), START, RING);
     let (_, now2) = until_look(&mut n, START, now);
     n.on_vision(&answer(VisionStatus::Found, [0.0; 3], 0.0, &[]));
     let mut t = now2;
@@ -106,14 +110,14 @@ fn the_goal_ends_it_a_held_step_is_given_up_and_a_walled_in_robot_fails() {
     }
     assert!(looked, "the step was given up and the robot looked again");
     // A look nobody answers is asked again after the timeout.
-    let mut n = Neptune::new(goal(), START);
+    let mut n = Neptune::new(goal(), START, RING);
     let (_, asked) = until_look(&mut n, START, t);
     let again: Vec<u64> =
         (1..=100).map(|k| asked + k * TICK).filter(|&t| n.on_odometry(START, t).0.is_some()).collect();
     assert_eq!(again, [asked + 40 * TICK, asked + 80 * TICK], "every 2 s");
     // A position model outside the room: no path, and the mission fails.
     let lost = Pose2::new(9.0, 3.0, 0.0);
-    let mut n = Neptune::new(goal(), lost);
+    let mut n = Neptune::new(goal(), lost, RING);
     until_look(&mut n, lost, t);
     n.on_vision(&answer(VisionStatus::Found, [0.0; 3], 0.0, &[]));
     assert_eq!(n.done, Some(false));
@@ -121,7 +125,7 @@ fn the_goal_ends_it_a_held_step_is_given_up_and_a_walled_in_robot_fails() {
 
 #[test]
 fn a_path_round_one_side_is_kept_while_the_other_is_not_much_cheaper() {
-    let mut n = Neptune::new(goal(), START);
+    let mut n = Neptune::new(goal(), START, RING);
     // A post straight ahead on the line to the goal: either side is as good.
     n.obstacles.push(([3.0, 3.0], [0.8, 3.0]));
     let first = n.plan([0.8, 3.0]).expect("a path");
@@ -143,4 +147,54 @@ fn a_path_round_one_side_is_kept_while_the_other_is_not_much_cheaper() {
     }
     n.plan(other).expect("a path");
     assert_eq!((n.route[n.route.len() / 3][1] - 3.0).signum(), -side, "{:?}", n.route);
+}
+
+/// A ring whose sensor ahead hears something `ahead_m` from the ring, the panic-stop set, and
+/// (if `behind_m`) the sensor straight behind something that near.
+fn held_ring(ahead_m: f32, behind_m: Option<f32>) -> SonarRing {
+    let mut r = SonarRing { panic_stop: 1, ..SonarRing::default() };
+    for i in 0..r.range_m.len() {
+        r.bearing_rad[i] = (i as f32 * 15.0).to_radians();
+        r.range_m[i] = 3.0;
+    }
+    r.range_m[0] = ahead_m;
+    if let Some(b) = behind_m {
+        r.range_m[12] = b;
+    }
+    r.valid_mask = (1 << r.range_m.len()) - 1;
+    r
+}
+
+#[test]
+fn a_step_the_panic_stop_holds_ends_its_echoes_mapped_and_the_robot_backs_off() {
+    let mut n = Neptune::new(goal(), START, RING);
+    n.route = vec![[1.2, 3.0], [7.2, 3.0]];
+    n.phase = Phase::Moving { to: [1.2, 3.0], deadline_ns: 0 };
+    n.on_sonar(&held_ring(0.25, None));
+    let (_, command, state) = n.on_odometry(START, 0);
+    assert_eq!((command.linear_mps, state.fsa_state), (0.0, 4), "held: it stops, then backs");
+    // The echo 0.48 m ahead is mapped across its beam (0.52 rad: seven points, at most 5 degrees
+    // apart), and the route that led into it is dropped.
+    assert_eq!(n.obstacles.len(), 7, "{:?}", n.obstacles);
+    for (p, from) in &n.obstacles {
+        let d = (p[0] - from[0]).hypot(p[1] - from[1]);
+        let a = (p[1] - from[1]).atan2(p[0] - from[0]).to_degrees();
+        assert!((d - 0.48).abs() < 1e-9 && a.abs() <= 15.0 + 1e-9, "{p:?} from {from:?}");
+    }
+    assert!(n.route.is_empty());
+    // It backs straight until the encoders have 0.2 m behind them, then settles to look.
+    let (_, command, _) = n.on_odometry(START, TICK);
+    assert_eq!((command.linear_mps, command.angular_radps), (-0.2, 0.0));
+    let (_, command, _) = n.on_odometry(Pose2::new(0.7, 3.0, 0.0), 2 * TICK);
+    assert_eq!(command.linear_mps, -0.2, "0.1 m back, not yet");
+    let (_, command, state) = n.on_odometry(Pose2::new(0.6, 3.0, 0.0), 3 * TICK);
+    assert_eq!((command.linear_mps, state.fsa_state), (0.0, 0), "settling");
+    // Something heard just behind: it does not back into it, and settles to look at once.
+    let mut n = Neptune::new(goal(), START, RING);
+    n.phase = Phase::Moving { to: [1.2, 3.0], deadline_ns: 0 };
+    n.on_sonar(&held_ring(0.25, Some(0.5)));
+    let (_, _, state) = n.on_odometry(START, 0);
+    assert_eq!(state.fsa_state, 0, "settling, not backing");
+    let (_, command, _) = n.on_odometry(START, TICK);
+    assert_eq!(command.linear_mps, 0.0);
 }

@@ -60,7 +60,8 @@ pub(crate) fn check_neptune(k: &KeyPath, n: &NeptuneGoal) -> Result<(), OutOfRan
     check(&k.key("turn_gain"), n.turn_gain, &TURN_GAIN)?;
     check(&k.key("arrive_m"), n.arrive_m, &LENGTH)?;
     check(&k.key("aligned_deg"), n.aligned_deg, &HALF_TURN)?;
-    check(&k.key("max_step_turn_deg"), n.max_step_turn_deg, &HALF_TURN)
+    check(&k.key("max_step_turn_deg"), n.max_step_turn_deg, &HALF_TURN)?;
+    check(&k.key("back_off_m"), n.back_off_m, &LENGTH)
 }
 
 pub(crate) fn check_ptrans(k: &KeyPath, p: &PtransGoal) -> Result<(), OutOfRange> {

@@ -194,6 +194,10 @@ pub struct NeptuneGoal {
     /// A wider turn is a step of its own (a stop to look after it), so that two stops' views
     /// share enough features.
     pub max_step_turn_deg: f64,
+    /// A step the sonar's panic-stop holds back ends; the robot backs this far (m) by its
+    /// encoders before it looks (unless the ring hears something behind it within that and the
+    /// panic-stop's reach), so the next path starts outside what held it.
+    pub back_off_m: f64,
 }
 
 pub(crate) fn check_neptune(n: &NeptuneGoal) -> Result<(), &'static str> {
