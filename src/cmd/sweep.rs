@@ -154,12 +154,11 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<i32> {
     let mut order = Vec::new();
     let ending = runner::run_all(&exe, jobs, max, &out, &interrupt, |d| {
         let row = finish(d, &cond_names, figure, args.keep);
-        // A run that ended without a status most often never started (a mission or world file
-        // it could not read): its own error says why.
-        let why = match row.figures {
-            None if !row.succeeded() => last_error(&row.log).map(|e| format!(" ({e})")),
-            _ => None,
-        };
+        // A failed run whose recording holds no mission status most often never started (a
+        // mission or world file it could not read): its own error says why.
+        let no_status = row.figures.as_ref().and_then(|f| f.state).is_none();
+        let why = (no_status && !row.succeeded()).then(|| last_error(&row.log)).flatten();
+        let why = why.map(|e| format!(" ({e})"));
         say(format!(
             "  {} s{}: {}, {}: {}{}",
             row.condition,
@@ -227,7 +226,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<i32> {
 /// The last line of a run's log that reports an error (`harvey: error: ...`), if any.
 fn last_error(log: &Path) -> Option<String> {
     let text = std::fs::read_to_string(log).ok()?;
-    let line = text.lines().rev().find(|l| l.contains("error:"))?;
+    let line = text.lines().rev().find(|l| l.starts_with("harvey: error:"))?;
     Some(line.trim().chars().take(300).collect())
 }
 
@@ -274,7 +273,7 @@ mod tests {
         let dir = std::env::temp_dir().join(format!("harvey-sweep-last-error-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("a directory");
         let log = dir.join("harvey-run.log");
-        let text = "INFO camera mount misaligned\nharvey: error: first\nINFO more\nharvey: error: a.toml: key `x`: unknown field\n";
+        let text = "INFO camera mount misaligned\nharvey: error: first\nWARN a service: error: not this\nharvey: error: a.toml: key `x`: unknown field\nERROR another: error: nor this\n";
         std::fs::write(&log, text).expect("written");
         assert_eq!(last_error(&log).as_deref(), Some("harvey: error: a.toml: key `x`: unknown field"));
         std::fs::write(&log, "INFO all well\n").expect("written");
