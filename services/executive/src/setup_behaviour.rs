@@ -50,7 +50,7 @@ impl Site<'_> {
     }
 
     /// The docking behaviour or the pole hunt (the acceptor, the camera, the sonar, the seed),
-    /// CMU's navigation (its start, the sonar ring's radius), door finding (the sonar ring's radius, the start), path
+    /// CMU's navigation (its start, the sonar ring), door finding (the sonar ring's radius, the start), path
     /// following (the path's edges, the camera), or depth from motion (the camera).
     pub(super) fn behaviour(&self, seed: u64) -> Result<Option<Behaviour>, SetupError> {
         let m = self.mission;

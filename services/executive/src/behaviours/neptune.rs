@@ -5,8 +5,9 @@
 //! the solved steps measured of them, `odo_scale.rs`), the obstacle points join the
 //! map, a path is planned round them to the goal, and the robot goes a step along it: turns
 //! towards the step's end, drives to it by the encoders, and stops to look again. A step the
-//! sonar's panic-stop holds back ends there, and the echoes that held it join the map (stereo
-//! ranges nothing nearer than 003's near limit, so a corner first seen close is the sonar's).
+//! sonar's panic-stop holds back ends there, the ring's near echoes join the map (stereo ranges
+//! nothing nearer than 003's near limit, so a corner first met close is the sonar's), and the
+//! robot backs off as far as the way behind allows before it looks (`neptune_held.rs`).
 
 use harvey_geometry::wrap;
 use harvey_msgs::{
@@ -52,9 +53,10 @@ enum Phase {
         deadline_ns: u64,
     },
     /// Backing straight from `from` (the encoders' frame) after the panic-stop held a step back,
-    /// until `back_off_m` is behind it or the deadline.
+    /// until `back_m` is behind it, the way behind closes, or the deadline.
     Backing {
         from: [f64; 2],
+        back_m: f64,
         deadline_ns: u64,
     },
 }
@@ -73,6 +75,10 @@ pub struct Neptune {
     /// Obstacle points seen (world frame, m), each with where it was seen from.
     obstacles: Vec<([f64; 2], [f64; 2])>,
     sonar: Sonar,
+    /// The ring's sensors with something near on successive readings.
+    near: held::NearStreaks,
+    /// Steps the panic-stop held back.
+    pub holds: u32,
     /// The path the last step was taken along (world frame, the goal last).
     route: Vec<[f64; 2]>,
     /// The encoders' distance scale the solved steps measure.
@@ -90,6 +96,8 @@ impl Neptune {
         Self {
             g,
             sonar,
+            near: held::NearStreaks::default(),
+            holds: 0,
             phase: Phase::Settling { since_ns: None },
             model: start,
             looked_at: None,
@@ -108,6 +116,7 @@ impl Neptune {
 
     pub fn on_sonar(&mut self, r: &SonarRing) {
         self.ring = Some(*r);
+        self.near.update(r, self.sonar.ring_m, self.g.clearance_m);
     }
 
     /// The position model carried on by the encoders since the last look.
@@ -165,7 +174,7 @@ impl Neptune {
         }
         let here = [self.model.x_m, self.model.y_m];
         if (here[0] - self.g.goal_m[0]).hypot(here[1] - self.g.goal_m[1]) <= self.g.goal_tolerance_m {
-            tracing::info!(stops = self.stops, unsolved = self.unsolved, "at the goal");
+            tracing::info!(stops = self.stops, unsolved = self.unsolved, holds = self.holds, "at the goal");
             self.done = Some(true);
             return;
         }
@@ -274,9 +283,11 @@ impl Neptune {
                 let held = self.ring.is_some_and(|r| r.panic_stop != 0);
                 if held {
                     self.map_echoes();
-                    let deadline_ns = now + allowance(g.back_off_m / g.speed_mps);
-                    self.phase = match self.room_behind() {
-                        true => Phase::Backing { from: [at.x_m, at.y_m], deadline_ns },
+                    let back_m = self.room_behind();
+                    let deadline_ns = now + allowance(back_m / g.speed_mps);
+                    // A back-off no longer than a step's arrival tolerance is none (and ends one).
+                    self.phase = match back_m > g.arrive_m {
+                        true => Phase::Backing { from: [at.x_m, at.y_m], back_m, deadline_ns },
                         false => Phase::Settling { since_ns: Some(now) },
                     };
                     (0.0, 0.0)
@@ -289,8 +300,9 @@ impl Neptune {
                     (g.speed_mps.min(ahead), (g.turn_gain * e).clamp(-max_turn, max_turn))
                 }
             }
-            Phase::Backing { from, deadline_ns } => {
-                if (at.x_m - from[0]).hypot(at.y_m - from[1]) >= g.back_off_m || now >= deadline_ns {
+            Phase::Backing { from, back_m, deadline_ns } => {
+                let backed = (at.x_m - from[0]).hypot(at.y_m - from[1]);
+                if backed >= back_m || now >= deadline_ns || self.room_behind() <= g.arrive_m {
                     self.phase = Phase::Settling { since_ns: Some(now) };
                     (0.0, 0.0)
                 } else {

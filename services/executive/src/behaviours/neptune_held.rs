@@ -1,10 +1,11 @@
 //! A step of CMU's navigation the sonar's panic-stop holds back (001 §6.2): the ring's near
-//! echoes mapped as obstacles across their beams, and whether there is room to back off.
+//! echoes, each confirmed by a second reading, mapped as obstacles across their beams, and how
+//! far the way behind lets the robot back off.
 
-use harvey_geometry::wrap;
+use harvey_msgs::{SONAR_SENSORS, SonarRing};
 
 use super::Neptune;
-use crate::behaviours::drive;
+use crate::script::clearance::Clearance;
 
 /// The sonar ring as the robot knows it (the world's `[robot]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -18,39 +19,70 @@ pub struct Sonar {
 /// An echo is mapped as points across its beam at most this far apart (rad; 5 degrees).
 const ARC_STEP_RAD: f64 = 0.087;
 
+/// Each sensor's fresh readings in a row that put something within the planner's clearance
+/// (one alone may be crosstalk, as the sonar service's panic-stop also asks for two).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(super) struct NearStreaks {
+    stamp_ns: [u64; SONAR_SENSORS],
+    count: [u8; SONAR_SENSORS],
+}
+
+impl NearStreaks {
+    /// Counts the sensors `ring` read afresh: on while the echo is within `near_m` of the
+    /// robot's centre (`ring_m` out to the sensors), back to 0 when it is not.
+    pub(super) fn update(&mut self, ring: &SonarRing, ring_m: f64, near_m: f64) {
+        for i in 0..SONAR_SENSORS {
+            if ring.reading_stamp_ns[i] == self.stamp_ns[i] {
+                continue;
+            }
+            self.stamp_ns[i] = ring.reading_stamp_ns[i];
+            let range = f64::from(ring.range_m[i]);
+            let near = ring.valid_mask & (1 << i) != 0 && range.is_finite() && ring_m + range <= near_m;
+            self.count[i] = if near { self.count[i].saturating_add(1) } else { 0 };
+        }
+    }
+
+    fn confirmed(&self, i: usize) -> bool {
+        self.count[i] >= 2
+    }
+}
+
 impl Neptune {
-    /// The ring's echoes within the planner's clearance, mapped where the model puts them: what
-    /// held the robot back (the panic-stop watches ahead; whatever else is that near counts too),
-    /// each as an arc across its beam (the echo says how far, not where across the beam: the
-    /// sonar maps of Moravec and Elfes, 003's lab). The route that led here is dropped.
+    /// The ring's confirmed echoes within the planner's clearance, mapped where the model puts
+    /// them: what held the robot back (the panic-stop watches ahead; whatever else is that near
+    /// counts too), each as an arc across its beam from its sensor (the echo says how far, not
+    /// where across the beam: the sonar maps of Moravec and Elfes, 003's lab). The route that
+    /// led here is dropped.
     pub(super) fn map_echoes(&mut self) {
         let Some(ring) = self.ring else { return };
         let at = self.believed();
-        let from = [at.x_m, at.y_m];
         let half = self.sonar.beam_rad / 2.0;
-        let n = (half / ARC_STEP_RAD).ceil() as i32;
+        let n = (half / ARC_STEP_RAD).ceil().max(1.0) as i32;
         let mut echoes = 0;
-        for (b, d) in drive::echoes(&ring, at.heading_rad, self.sonar.ring_m) {
-            if d > self.g.clearance_m {
-                continue;
-            }
+        for i in (0..SONAR_SENSORS).filter(|&i| self.near.confirmed(i)) {
+            let b = at.heading_rad + f64::from(ring.bearing_rad[i]);
+            let d = f64::from(ring.range_m[i]);
+            let sensor = [at.x_m + self.sonar.ring_m * b.cos(), at.y_m + self.sonar.ring_m * b.sin()];
             echoes += 1;
             for k in -n..=n {
-                let a = b + half * f64::from(k) / f64::from(n.max(1));
-                self.obstacles.push(([from[0] + d * a.cos(), from[1] + d * a.sin()], from));
+                let a = b + half * f64::from(k) / f64::from(n);
+                self.obstacles.push(([sensor[0] + d * a.cos(), sensor[1] + d * a.sin()], sensor));
             }
         }
         self.route.clear();
-        tracing::info!(stop = self.stops, echoes, "held back by the panic-stop: the near echoes mapped");
+        self.holds += 1;
+        tracing::info!(
+            stop = self.stops,
+            echoes,
+            holds = self.holds,
+            "held back by the panic-stop: near echoes mapped"
+        );
     }
 
-    /// Whether the ring hears nothing within 30 degrees of straight behind nearer than the
-    /// back-off and the planner's clearance.
-    pub(super) fn room_behind(&self) -> bool {
-        let Some(ring) = &self.ring else { return false };
-        let reach = self.g.clearance_m + self.g.back_off_m;
-        let behind = std::f64::consts::FRAC_PI_6;
-        drive::echoes(ring, 0.0, self.sonar.ring_m)
-            .all(|(b, d)| wrap(b - std::f64::consts::PI).abs() > behind || d > reach)
+    /// How far the robot may back now: the way behind as the latest ring shows it (no
+    /// panic-stop watches it), at most `back_off_m`.
+    pub(super) fn room_behind(&self) -> f64 {
+        let clear = self.ring.as_ref().map_or(0.0, |r| Clearance::of(r).may_back_m());
+        clear.min(self.g.back_off_m)
     }
 }

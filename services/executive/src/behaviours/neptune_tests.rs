@@ -149,17 +149,17 @@ fn a_path_round_one_side_is_kept_while_the_other_is_not_much_cheaper() {
     assert_eq!((n.route[n.route.len() / 3][1] - 3.0).signum(), -side, "{:?}", n.route);
 }
 
-/// A ring whose sensor ahead hears something `ahead_m` from the ring, the panic-stop set, and
-/// (if `behind_m`) the sensor straight behind something that near.
-fn held_ring(ahead_m: f32, behind_m: Option<f32>) -> SonarRing {
+/// A ring read at `stamp` whose sensors hear `ranges` (index: sensor, 15 degrees apart from
+/// ahead; the rest hear nothing within 3 m), the panic-stop set.
+fn held_ring(stamp: u64, ranges: &[(usize, f32)]) -> SonarRing {
     let mut r = SonarRing { panic_stop: 1, ..SonarRing::default() };
     for i in 0..r.range_m.len() {
         r.bearing_rad[i] = (i as f32 * 15.0).to_radians();
         r.range_m[i] = 3.0;
+        r.reading_stamp_ns[i] = stamp;
     }
-    r.range_m[0] = ahead_m;
-    if let Some(b) = behind_m {
-        r.range_m[12] = b;
+    for &(i, range) in ranges {
+        r.range_m[i] = range;
     }
     r.valid_mask = (1 << r.range_m.len()) - 1;
     r
@@ -167,34 +167,71 @@ fn held_ring(ahead_m: f32, behind_m: Option<f32>) -> SonarRing {
 
 #[test]
 fn a_step_the_panic_stop_holds_ends_its_echoes_mapped_and_the_robot_backs_off() {
-    let mut n = Neptune::new(goal(), START, RING);
-    n.route = vec![[1.2, 3.0], [7.2, 3.0]];
-    n.phase = Phase::Moving { to: [1.2, 3.0], deadline_ns: 0 };
-    n.on_sonar(&held_ring(0.25, None));
-    let (_, command, state) = n.on_odometry(START, 0);
-    assert_eq!((command.linear_mps, state.fsa_state), (0.0, 4), "held: it stops, then backs");
-    // The echo 0.48 m ahead is mapped across its beam (0.52 rad: seven points, at most 5 degrees
-    // apart), and the route that led into it is dropped.
+    // Facing north; the sensor 15 degrees left of ahead hears something 0.25 m out twice.
+    let facing = Pose2::new(0.8, 3.0, std::f64::consts::FRAC_PI_2);
+    let mut n = Neptune::new(goal(), facing, RING);
+    n.route = vec![[0.8, 3.4], [7.2, 3.0]];
+    n.phase = Phase::Moving { to: [0.8, 3.4], deadline_ns: 0 };
+    n.on_sonar(&held_ring(1, &[(1, 0.25), (5, 2.0)]));
+    n.on_sonar(&held_ring(2, &[(1, 0.25), (5, 0.3)]));
+    let (_, command, state) = n.on_odometry(facing, 0);
+    assert_eq!((command.linear_mps, state.fsa_state, n.holds), (0.0, 4, 1), "held: it stops, then backs");
+    // The echo is mapped from its sensor (0.23 m out at 105 degrees) across its beam (0.52
+    // rad: seven points at most 5 degrees apart); sensor 5's single near reading is not (one
+    // alone may be crosstalk); the route that led here is dropped.
     assert_eq!(n.obstacles.len(), 7, "{:?}", n.obstacles);
+    let b = 105f64.to_radians();
+    let sensor = [0.8 + 0.23 * b.cos(), 3.0 + 0.23 * b.sin()];
     for (p, from) in &n.obstacles {
-        let d = (p[0] - from[0]).hypot(p[1] - from[1]);
-        let a = (p[1] - from[1]).atan2(p[0] - from[0]).to_degrees();
-        assert!((d - 0.48).abs() < 1e-9 && a.abs() <= 15.0 + 1e-9, "{p:?} from {from:?}");
+        let d = (p[0] - sensor[0]).hypot(p[1] - sensor[1]);
+        let off = ((p[1] - sensor[1]).atan2(p[0] - sensor[0]) - b).to_degrees();
+        assert!((d - 0.25).abs() < 1e-6 && off.abs() <= 15.0 + 1e-6, "{p:?}");
+        assert!((from[0] - sensor[0]).abs() < 1e-6 && (from[1] - sensor[1]).abs() < 1e-6);
     }
     assert!(n.route.is_empty());
+    // The next path turns off it: its first step ends well away from the echo.
+    let echo = [sensor[0] + 0.25 * b.cos(), sensor[1] + 0.25 * b.sin()];
+    let mut planner = n.clone();
+    let next = planner.plan([0.8, 3.0]).expect("a path");
+    assert!((next[0] - echo[0]).hypot(next[1] - echo[1]) > 0.35, "{next:?} by {echo:?}");
     // It backs straight until the encoders have 0.2 m behind them, then settles to look.
-    let (_, command, _) = n.on_odometry(START, TICK);
+    let (_, command, _) = n.on_odometry(facing, TICK);
     assert_eq!((command.linear_mps, command.angular_radps), (-0.2, 0.0));
-    let (_, command, _) = n.on_odometry(Pose2::new(0.7, 3.0, 0.0), 2 * TICK);
+    let (_, command, _) = n.on_odometry(Pose2 { y_m: 2.9, ..facing }, 2 * TICK);
     assert_eq!(command.linear_mps, -0.2, "0.1 m back, not yet");
-    let (_, command, state) = n.on_odometry(Pose2::new(0.6, 3.0, 0.0), 3 * TICK);
+    let (_, command, state) = n.on_odometry(Pose2 { y_m: 2.79, ..facing }, 3 * TICK);
     assert_eq!((command.linear_mps, state.fsa_state), (0.0, 0), "settling");
-    // Something heard just behind: it does not back into it, and settles to look at once.
-    let mut n = Neptune::new(goal(), START, RING);
-    n.phase = Phase::Moving { to: [1.2, 3.0], deadline_ns: 0 };
-    n.on_sonar(&held_ring(0.25, Some(0.5)));
-    let (_, _, state) = n.on_odometry(START, 0);
-    assert_eq!(state.fsa_state, 0, "settling, not backing");
-    let (_, command, _) = n.on_odometry(START, TICK);
-    assert_eq!(command.linear_mps, 0.0);
+}
+
+#[test]
+fn a_held_robot_backs_only_as_far_as_the_way_behind_is_clear() {
+    let held = |behind: &[(usize, f32)]| {
+        let mut n = Neptune::new(goal(), START, RING);
+        n.phase = Phase::Moving { to: [1.2, 3.0], deadline_ns: 0 };
+        let ahead: Vec<(usize, f32)> = [(0, 0.25)].into_iter().chain(behind.iter().copied()).collect();
+        n.on_sonar(&held_ring(1, &ahead));
+        n.on_sonar(&held_ring(2, &ahead));
+        n.on_odometry(START, 0);
+        n
+    };
+    // Something 0.45 m behind the sensor 30 degrees off straight behind (210 degrees): 0.15 m
+    // of the 0.2 m (0.3 m kept), and the same at 150 degrees.
+    for sensor in [10, 14] {
+        let n = held(&[(sensor, 0.45)]);
+        let Phase::Backing { back_m, .. } = n.phase else { panic!("{:?}", n.phase) };
+        assert!((back_m - 0.15).abs() < 1e-6, "sensor {sensor}: {back_m}");
+    }
+    // 0.3 m behind: no room (a back-off within a step's 2 cm arrival is none), it settles to look.
+    let n = held(&[(12, 0.3)]);
+    assert!(matches!(n.phase, Phase::Settling { .. }), "{:?}", n.phase);
+    // The way behind closing to 1 cm while it backs stops it; so does the deadline (2 x 1 s + 3 s).
+    let mut n = held(&[]);
+    n.on_sonar(&held_ring(3, &[(12, 0.31)]));
+    let (_, command, state) = n.on_odometry(START, TICK);
+    assert_eq!((command.linear_mps, state.fsa_state), (0.0, 0), "the way behind closed");
+    let mut n = held(&[]);
+    let (_, command, _) = n.on_odometry(START, 4_900_000_000);
+    assert_eq!(command.linear_mps, -0.2, "stuck but within the deadline");
+    let (_, command, _) = n.on_odometry(START, 5_000_000_000);
+    assert_eq!(command.linear_mps, 0.0, "the deadline");
 }

@@ -194,9 +194,9 @@ pub struct NeptuneGoal {
     /// A wider turn is a step of its own (a stop to look after it), so that two stops' views
     /// share enough features.
     pub max_step_turn_deg: f64,
-    /// A step the sonar's panic-stop holds back ends; the robot backs this far (m) by its
-    /// encoders before it looks (unless the ring hears something behind it within that and the
-    /// panic-stop's reach), so the next path starts outside what held it.
+    /// A step the sonar's panic-stop holds back ends; the robot backs up to this far (m) by its
+    /// encoders before it looks, as far as the ring shows the way behind clear, so that the next
+    /// path starts outside what held it. At most `step_m`.
     pub back_off_m: f64,
 }
 
@@ -215,6 +215,9 @@ pub(crate) fn check_neptune(n: &NeptuneGoal) -> Result<(), &'static str> {
     }
     if n.arrive_m >= n.step_m {
         return Err("arrive_m is not less than step_m");
+    }
+    if n.back_off_m > n.step_m {
+        return Err("back_off_m is more than step_m");
     }
     Ok(())
 }

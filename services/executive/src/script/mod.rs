@@ -5,7 +5,7 @@
 //! comes after the last step is the [`Sequel`]'s: nothing for a plain script, more steps for
 //! plan-and-monitor.
 
-mod clearance;
+pub(crate) mod clearance;
 pub mod leg;
 pub mod recover;
 mod refining;
