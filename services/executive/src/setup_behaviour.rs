@@ -50,8 +50,8 @@ impl Site<'_> {
     }
 
     /// The docking behaviour or the pole hunt (the acceptor, the camera, the sonar, the seed),
-    /// CMU's navigation (its start, the sonar ring), door finding (the sonar ring's radius, the start), path
-    /// following (the path's edges, the camera), or depth from motion (the camera).
+    /// CMU's navigation (its start, the sonar ring), door finding (the sonar ring's radius, the
+    /// start), path following (the path's edges, the camera), or depth from motion (the camera).
     pub(super) fn behaviour(&self, seed: u64) -> Result<Option<Behaviour>, SetupError> {
         let m = self.mission;
         if let Some(g) = &m.neptune {
@@ -59,7 +59,7 @@ impl Site<'_> {
             let r = &w.robot;
             let sonar =
                 Sonar { ring_m: r.sonar_ring_radius_m, beam_rad: r.sonar_beam_width_deg.to_radians() };
-            let n = Neptune::new(g.clone(), w.start, sonar);
+            let n = Neptune::new(*g, w.start, sonar);
             return Ok(Some(Behaviour::Neptune(Box::new(n))));
         }
         if let Some(g) = &m.path {

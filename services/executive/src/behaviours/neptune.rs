@@ -229,7 +229,7 @@ impl Neptune {
         now: u64,
     ) -> (Option<VisionRequest>, MotionCommand, BehaviourState) {
         self.at = at;
-        let g = self.g.clone();
+        let g = self.g;
         let max_turn = g.max_turn_degps.to_radians();
         let mut look = None;
         let vw = match self.phase {

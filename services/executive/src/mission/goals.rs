@@ -160,7 +160,7 @@ pub struct PolesGoal {
 /// CMU's stop-go-stop navigation by stereo alone (`[mission.neptune]`, 003): to the goal in
 /// steps, looking at each stop, the position model from visual odometry, the path planned round
 /// the obstacles stereo saw.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct NeptuneGoal {
     /// The goal on the floor (m), and how near the position model must put the robot.
