@@ -1,8 +1,9 @@
 //! Opening a chunk: its records decompressed within limits and checked against the chunk's CRC
 //! before any of them is parsed or handed on. A chunk may claim at most what its compressed bytes
 //! could decompress to (the codec's largest ratio) and never more than [`MAX_CHUNK_BYTES`], so a
-//! flipped bit in a size is an error, not an allocation; the output buffer grows with what is
-//! actually decompressed, never with what is claimed.
+//! flipped bit in a size is an error, not an allocation: a zstd chunk is decompressed in one call
+//! into a buffer of its claimed size only up to 64 MiB (a chunk is ~4 MiB), past that the output
+//! buffer grows with what is actually decompressed, never with what is claimed.
 
 use std::borrow::Cow;
 use std::io::Read;
@@ -30,28 +31,80 @@ const FIRST_RESERVE: u64 = 8 << 20;
 /// from `data` when the chunk is not compressed. A CRC of 0 is "not computed" (the MCAP
 /// specification); [`Opened::verified`] says whether it was checked.
 pub(crate) fn open<'a>(header: &ChunkHeader, data: &'a [u8]) -> Result<Opened<'a>, Damage> {
-    let (claims, compressed) = (header.uncompressed_size, data.len() as u64);
-    let records: Cow<'a, [u8]> = match header.compression.as_str() {
-        "" if claims == compressed => Cow::Borrowed(data),
-        "" => return Err(Damage::ChunkSize { claims, got: compressed }),
-        "zstd" => {
-            within(claims, compressed, MAX_ZSTD_RATIO)?;
-            Cow::Owned(guarded(|| unzstd(data, claims), Damage::Decompress)?)
+    Unpacker::default().open(header, data)
+}
+
+/// Opens chunk after chunk with one zstd context and one output buffer: a reader's chunks
+/// (about 4 MiB each, `writer.rs`) are decompressed straight into the buffer the last chunk's
+/// records were in ([`Unpacker::give_back`]), not each into fresh pages through a fresh context
+/// and a stream's window.
+#[derive(Default)]
+pub(crate) struct Unpacker {
+    zstd: Option<zstd::bulk::Decompressor<'static>>,
+    spare: Vec<u8>,
+}
+
+/// A zstd chunk claiming at most this much is decompressed in one call into a buffer of the
+/// claimed size; a larger claim (one message bigger than a chunk, or a flipped bit in the size)
+/// is streamed into a buffer that grows with what actually comes out.
+const BULK_MAX_BYTES: u64 = 64 << 20;
+
+impl Unpacker {
+    /// [`open`], reusing this unpacker's context and buffer.
+    pub fn open<'a>(&mut self, header: &ChunkHeader, data: &'a [u8]) -> Result<Opened<'a>, Damage> {
+        let (claims, compressed) = (header.uncompressed_size, data.len() as u64);
+        let records: Cow<'a, [u8]> = match header.compression.as_str() {
+            "" if claims == compressed => Cow::Borrowed(data),
+            "" => return Err(Damage::ChunkSize { claims, got: compressed }),
+            "zstd" => {
+                within(claims, compressed, MAX_ZSTD_RATIO)?;
+                Cow::Owned(guarded(|| self.unzstd(data, claims), Damage::Decompress)?)
+            }
+            "lz4" => {
+                within(claims, compressed, MAX_LZ4_RATIO)?;
+                Cow::Owned(guarded(|| unlz4(data, claims), Damage::Decompress)?)
+            }
+            other => return Err(Damage::Compression(other.to_owned())),
+        };
+        let saved = header.uncompressed_crc;
+        if saved != 0 {
+            let calculated = crc32fast::hash(&records);
+            if calculated != saved {
+                return Err(Damage::ChunkCrc { saved, calculated });
+            }
         }
-        "lz4" => {
-            within(claims, compressed, MAX_LZ4_RATIO)?;
-            Cow::Owned(guarded(|| unlz4(data, claims), Damage::Decompress)?)
-        }
-        other => return Err(Damage::Compression(other.to_owned())),
-    };
-    let saved = header.uncompressed_crc;
-    if saved != 0 {
-        let calculated = crc32fast::hash(&records);
-        if calculated != saved {
-            return Err(Damage::ChunkCrc { saved, calculated });
+        Ok(Opened { records, verified: saved != 0 })
+    }
+
+    /// Takes back the buffer of a chunk's records read out, for the next chunk.
+    pub fn give_back(&mut self, records: Vec<u8>) {
+        if records.capacity() > self.spare.capacity() {
+            self.spare = records;
         }
     }
-    Ok(Opened { records, verified: saved != 0 })
+
+    /// Decompresses zstd `data`, which must come to exactly `claims` bytes: in one call when the
+    /// claim is small enough to allocate, else (or to tell how much more there is) streamed.
+    fn unzstd(&mut self, data: &[u8], claims: u64) -> Result<Vec<u8>, Damage> {
+        if claims > BULK_MAX_BYTES {
+            return unzstd(data, claims);
+        }
+        let mut out = std::mem::take(&mut self.spare);
+        out.clear();
+        out.reserve(claims as usize + 1);
+        let zstd = match &mut self.zstd {
+            Some(z) => z,
+            None => self
+                .zstd
+                .insert(zstd::bulk::Decompressor::new().map_err(|e| Damage::Decompress(e.to_string()))?),
+        };
+        match zstd.decompress_to_buffer(data, &mut out) {
+            Ok(got) if got as u64 == claims => Ok(out),
+            Ok(got) => Err(Damage::ChunkSize { claims, got: got as u64 }),
+            // More than the buffer holds, or damage: the stream says which, and how much.
+            Err(_) => unzstd(data, claims),
+        }
+    }
 }
 
 /// A chunk's records, and whether a CRC vouched for them.
@@ -140,6 +193,31 @@ mod tests {
         assert!(matches!(open(&header("brotli", 1, b"x"), b"x"), Err(Damage::Compression(_))));
         let plain = open(&header("", 3, b"abc"), b"abc").expect("uncompressed");
         assert!(matches!(plain.records, Cow::Borrowed(b"abc")));
+    }
+
+    #[test]
+    fn one_unpacker_opens_chunk_after_chunk_in_the_buffer_it_was_given_back() {
+        let mut u = Unpacker::default();
+        let big: Vec<u8> = (0..300_000u32).map(|i| (i % 253) as u8).collect();
+        let small: Vec<u8> = (0..5_000u32).map(|i| (i % 7) as u8).collect();
+        let (zb, zs) =
+            (zstd::encode_all(&big[..], 3).expect("big"), zstd::encode_all(&small[..], 3).expect("small"));
+        let opened = u.open(&header("zstd", big.len() as u64, &big), &zb).expect("big chunk");
+        assert_eq!(&opened.records[..], &big[..]);
+        let Cow::Owned(records) = opened.records else { panic!("decompressed into its own buffer") };
+        let reused = records.as_ptr();
+        u.give_back(records);
+        let opened = u.open(&header("zstd", small.len() as u64, &small), &zs).expect("small chunk");
+        assert_eq!(&opened.records[..], &small[..]);
+        assert_eq!(opened.records.as_ptr(), reused, "the buffer given back");
+        // The buffer holds more than the claim: what comes out beyond it is still caught.
+        let Cow::Owned(records) = opened.records else { panic!("owned") };
+        u.give_back(records);
+        let short = header("zstd", small.len() as u64 - 1, &small);
+        assert!(matches!(u.open(&short, &zs), Err(Damage::ChunkSize { got: 5_000, .. })));
+        assert!(u.open(&header("zstd", 10, &small), &zs[..zs.len() / 2]).is_err(), "a cut frame");
+        let again = u.open(&header("zstd", big.len() as u64, &big), &zb).expect("big again");
+        assert_eq!(&again.records[..], &big[..]);
     }
 
     fn lz4(records: &[u8]) -> Vec<u8> {

@@ -11,7 +11,7 @@ use harvey_cdr::{Cdr, CdrError};
 use crate::RecordingError;
 use crate::damage::Damage;
 use crate::records::check_data_crc;
-use crate::stream::Stream;
+use crate::stream::{Linked, Stream};
 use crate::summary::Located;
 
 /// A recording read into memory.
@@ -133,7 +133,7 @@ impl<'a> Iterator for Messages<'a> {
 pub struct Message<'a> {
     file: &'a Path,
     index: usize,
-    inner: mcap::Message<'a>,
+    inner: Linked<'a>,
 }
 
 impl<'a> Message<'a> {
@@ -164,12 +164,12 @@ impl<'a> Message<'a> {
 
     /// The CDR payload.
     pub fn data(&self) -> &[u8] {
-        &self.inner.data
+        self.inner.data.bytes()
     }
 
     /// The payload, owned.
     pub fn into_data(self) -> Vec<u8> {
-        self.inner.data.into_owned()
+        self.inner.data.bytes().to_vec()
     }
 
     /// The payload decoded as `T`; an error names the file, the message and its topic.

@@ -5,6 +5,8 @@
 //! and for a damaged one the damage and the byte offset of the record it is in, never a panic.
 
 use std::borrow::Cow;
+use std::ops::Range;
+use std::sync::Arc;
 
 use mcap::read::ChannelAccumulator;
 use mcap::records::{Record, op};
@@ -25,11 +27,54 @@ enum Part {
     Done,
 }
 
+/// Where records lie: the file itself (and a chunk stored uncompressed in it), or a
+/// decompressed chunk, shared with the messages read from it.
+#[derive(Debug, Clone)]
+enum Records<'a> {
+    File(&'a [u8]),
+    Chunk(Arc<Vec<u8>>),
+}
+
+impl Records<'_> {
+    fn bytes(&self) -> &[u8] {
+        match self {
+            Records::File(b) => b,
+            Records::Chunk(b) => b,
+        }
+    }
+}
+
+/// A message's payload: bytes of the file, or a range of the decompressed chunk it came in
+/// (shared, not copied out).
+#[derive(Debug, Clone)]
+pub(crate) enum Payload<'a> {
+    File(&'a [u8]),
+    Chunk(Arc<Vec<u8>>, Range<usize>),
+}
+
+impl Payload<'_> {
+    pub fn bytes(&self) -> &[u8] {
+        match self {
+            Payload::File(b) => b,
+            Payload::Chunk(chunk, range) => &chunk[range.clone()],
+        }
+    }
+}
+
+/// A message linked to its channel, its payload where it lies.
+#[derive(Debug, Clone)]
+pub(crate) struct Linked<'a> {
+    pub channel: Arc<mcap::Channel<'static>>,
+    pub sequence: u32,
+    pub log_time: u64,
+    pub data: Payload<'a>,
+}
+
 /// The chunk whose records are being read.
 struct Open<'a> {
     /// The chunk record's offset in the file.
     offset: usize,
-    records: Cow<'a, [u8]>,
+    records: Records<'a>,
     at: usize,
 }
 
@@ -39,6 +84,7 @@ pub(crate) struct Stream<'a> {
     at: usize,
     part: Part,
     chunk: Option<Open<'a>>,
+    unpacker: chunk::Unpacker,
     channels: ChannelAccumulator<'static>,
 }
 
@@ -46,20 +92,25 @@ impl<'a> Stream<'a> {
     /// The messages of `bytes`, which must start with the MCAP magic.
     pub fn new(bytes: &'a [u8]) -> Self {
         let at = mcap::MAGIC.len();
-        Self { bytes, at, part: Part::Data, chunk: None, channels: ChannelAccumulator::default() }
+        let (chunk, unpacker, channels) = (None, chunk::Unpacker::default(), ChannelAccumulator::default());
+        Self { bytes, at, part: Part::Data, chunk, unpacker, channels }
     }
 
     /// The next message of the chunk being read, if it has one left.
-    fn next_in_chunk(&mut self) -> Option<Result<mcap::Message<'static>, Located>> {
+    fn next_in_chunk(&mut self) -> Option<Result<Linked<'a>, Located>> {
         loop {
             let open = self.chunk.as_mut()?;
-            if open.at >= open.records.len() {
-                self.chunk = None;
+            if open.at >= open.records.bytes().len() {
+                if let Some(Open { records: Records::Chunk(done), .. }) = self.chunk.take()
+                    && let Ok(done) = Arc::try_unwrap(done)
+                {
+                    self.unpacker.give_back(done);
+                }
                 return None;
             }
             let (offset, at) = (open.offset, open.at);
             let in_chunk = |what| located(offset, Damage::in_chunk(at as u64, what));
-            let raw = match record_at(&open.records, at) {
+            let raw = match record_at(open.records.bytes(), at) {
                 Ok(raw) => raw,
                 Err(what) => return Some(Err(in_chunk(what))),
             };
@@ -69,7 +120,13 @@ impl<'a> Stream<'a> {
                 continue;
             }
             match take(&mut self.channels, raw) {
-                Ok(Some(message)) => return Some(Ok(message)),
+                Ok(Some((m, range))) => {
+                    let data = match &open.records {
+                        Records::File(b) => Payload::File(&b[range]),
+                        Records::Chunk(b) => Payload::Chunk(Arc::clone(b), range),
+                    };
+                    return Some(Ok(m.with(data)));
+                }
                 Ok(None) => {}
                 Err(what) => return Some(Err(in_chunk(what))),
             }
@@ -77,7 +134,7 @@ impl<'a> Stream<'a> {
     }
 
     /// Reads the next top-level record: `Some` with a message or damage, `None` to read on.
-    fn step(&mut self) -> Option<Result<mcap::Message<'static>, Located>> {
+    fn step(&mut self) -> Option<Result<Linked<'a>, Located>> {
         let at = self.at;
         let here = |what| Some(Err(located(at, what)));
         if at >= self.bytes.len() {
@@ -93,12 +150,16 @@ impl<'a> Stream<'a> {
             (Part::Data, op::CHUNK) => match raw.parse() {
                 Ok(Record::Chunk { header, data }) => {
                     let opened = match data {
-                        Cow::Borrowed(data) => chunk::open(&header, data),
-                        Cow::Owned(data) => chunk::open(&header, &data).map(chunk::Opened::into_owned),
+                        Cow::Borrowed(data) => self.unpacker.open(&header, data),
+                        Cow::Owned(data) => self.unpacker.open(&header, &data).map(chunk::Opened::into_owned),
                     };
                     match opened {
                         Ok(opened) => {
-                            self.chunk = Some(Open { offset: at, records: opened.records, at: 0 });
+                            let records = match opened.records {
+                                Cow::Borrowed(b) => Records::File(b),
+                                Cow::Owned(b) => Records::Chunk(Arc::new(b)),
+                            };
+                            self.chunk = Some(Open { offset: at, records, at: 0 });
                             None
                         }
                         Err(what) => here(what),
@@ -120,7 +181,7 @@ impl<'a> Stream<'a> {
                 Err(what) => here(what),
             },
             (Part::Data, _) => match take(&mut self.channels, raw) {
-                Ok(Some(message)) => Some(Ok(message)),
+                Ok(Some((m, range))) => Some(Ok(m.with(Payload::File(&self.bytes[range])))),
                 Ok(None) => None,
                 Err(what) => here(what),
             },
@@ -146,12 +207,27 @@ impl<'a> Stream<'a> {
     }
 }
 
+/// A message's fields but its payload.
+struct Head {
+    channel: Arc<mcap::Channel<'static>>,
+    sequence: u32,
+    log_time: u64,
+}
+
+impl Head {
+    fn with(self, data: Payload<'_>) -> Linked<'_> {
+        let Head { channel, sequence, log_time } = self;
+        Linked { channel, sequence, log_time, data }
+    }
+}
+
 /// Takes a record of the data section (or of a chunk): schemas and channels are kept to link the
-/// messages that follow to; a message comes back linked; other records are parsed and left.
+/// messages that follow to; a message comes back linked, with where its payload lies in the bytes
+/// `raw` was read from (a message record's payload is its tail); other records are parsed and left.
 fn take(
     channels: &mut ChannelAccumulator<'static>,
     raw: Raw<'_>,
-) -> Result<Option<mcap::Message<'static>>, Damage> {
+) -> Result<Option<(Head, Range<usize>)>, Damage> {
     match raw.parse()? {
         Record::Schema { header, data } => {
             channels.add_schema(header, Cow::Owned(data.into_owned())).map_err(Damage::Link)?;
@@ -161,21 +237,17 @@ fn take(
             let channel = channels
                 .get(header.channel_id)
                 .ok_or(Damage::UnknownChannel { channel: header.channel_id })?;
-            return Ok(Some(mcap::Message {
-                channel,
-                sequence: header.sequence,
-                log_time: header.log_time,
-                publish_time: header.publish_time,
-                data: Cow::Owned(data.into_owned()),
-            }));
+            let (sequence, log_time) = (header.sequence, header.log_time);
+            let range = raw.end - data.len()..raw.end;
+            return Ok(Some((Head { channel, sequence, log_time }, range)));
         }
         _ => {}
     }
     Ok(None)
 }
 
-impl Iterator for Stream<'_> {
-    type Item = Result<mcap::Message<'static>, Located>;
+impl<'a> Iterator for Stream<'a> {
+    type Item = Result<Linked<'a>, Located>;
 
     fn next(&mut self) -> Option<Self::Item> {
         loop {
@@ -223,9 +295,19 @@ mod tests {
         }
         r.finish().expect("finish");
         let bytes = std::fs::read(&path).expect("read");
-        let ours: Vec<_> = Stream::new(&bytes).collect::<Result<_, _>>().expect("intact");
-        let theirs: Vec<_> =
-            mcap::MessageStream::new(&bytes).expect("mcap").collect::<Result<_, _>>().expect("intact");
+        let ours: Vec<_> = Stream::new(&bytes)
+            .map(|m| {
+                let m = m.expect("intact");
+                (m.channel, m.sequence, m.log_time, m.data.bytes().to_vec())
+            })
+            .collect();
+        let theirs: Vec<_> = mcap::MessageStream::new(&bytes)
+            .expect("mcap")
+            .map(|m| {
+                let m = m.expect("intact");
+                (m.channel, m.sequence, m.log_time, m.data.into_owned())
+            })
+            .collect();
         assert_eq!(ours.len(), 80);
         assert_eq!(ours, theirs);
         std::fs::remove_dir_all(&dir).ok();
