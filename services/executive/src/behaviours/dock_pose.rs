@@ -5,6 +5,7 @@ use harvey_msgs::Pose2;
 
 use harvey_geometry::wrap;
 
+use super::region::Region;
 use crate::mission::DockingGoal;
 
 /// What the dock recognised in the image says (the inverse perspective of 004 §4.1.3 on the
@@ -84,6 +85,22 @@ pub(crate) fn face_distance(g: &DockingGoal, at: Pose2) -> f64 {
     (at.x_m - g.dock_m[0]) * n.cos() + (at.y_m - g.dock_m[1]) * n.sin()
 }
 
+/// The distances from the dock's face the robot, believed `d` from it, may be at (near, far):
+/// over the UMS's `region` (and the belief), widened by `hough_band_min_m` either way; the
+/// paper's "plus or minus four feet" (`hough_range_sd_m`) while the UMS has published none.
+pub(crate) fn hough_band(g: &DockingGoal, region: Option<&Region>, d: f64) -> (f64, f64) {
+    let (near, far) = match region {
+        Some(region) => {
+            let (lo, hi) =
+                region.span(|p| face_distance(g, Pose2 { x_m: p[0], y_m: p[1], heading_rad: 0.0 }));
+            (lo.min(d) - g.hough_band_min_m, hi.max(d) + g.hough_band_min_m)
+        }
+        None => (d - g.hough_range_sd_m, d + g.hough_range_sd_m),
+    };
+    // Nearer than half a metre the frame is far wider than the image.
+    (near.max(0.5), far.max(0.5))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -146,5 +163,28 @@ mod tests {
         let (far, near) = (sd_deg_at(13.6 - 4.5), sd_deg_at(13.6 - 2.0));
         assert!((4.0..6.5).contains(&far), "{far}");
         assert!((0.7..1.5).contains(&near), "{near}");
+    }
+
+    #[test]
+    fn the_hough_s_scales_span_the_distances_the_ums_s_region_allows() {
+        let g = goal();
+        let close = |a: (f64, f64), b: (f64, f64)| (a.0 - b.0).abs() < 1e-9 && (a.1 - b.1).abs() < 1e-9;
+        // No region yet: the paper's four feet either way of the belief.
+        assert!(close(hough_band(&g, None, 5.6), (5.6 - 1.22, 5.6 + 1.22)));
+        let mut m = harvey_msgs::UncertaintyMap { vertex_count: 4, ..Default::default() };
+        for (k, v) in [[7.0, -1.0], [9.0, -1.0], [9.0, 1.0], [7.0, 1.0]].into_iter().enumerate() {
+            m.vertices_m[k] = v;
+        }
+        let region = Region::of(&m).expect("a region");
+        // The dock's face at x = 13.6 facing -x: the region lies 4.6-6.6 m from it.
+        assert!(close(hough_band(&g, Some(&region), 5.6), (4.3, 6.9)));
+        assert!(close(hough_band(&g, Some(&region), 4.0), (3.7, 6.9)), "the belief outside it counts too");
+        let near = Region::of(&{
+            let mut m = m.clone();
+            m.vertices_m[..4].copy_from_slice(&[[13.0, -0.1], [13.3, -0.1], [13.3, 0.1], [13.0, 0.1]]);
+            m
+        })
+        .expect("a region");
+        assert!(close(hough_band(&g, Some(&near), 0.4), (0.5, 0.9)), "never nearer than half a metre");
     }
 }

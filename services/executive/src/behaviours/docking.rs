@@ -13,7 +13,7 @@ use harvey_msgs::{
     VisionResult, VisionStatus,
 };
 
-use super::dock_pose::{dock_sight, face_distance, weighed_fix};
+use super::dock_pose::{dock_sight, face_distance, hough_band, weighed_fix};
 use super::drive::{self, DriveParams, Vectors};
 use super::fsa::{Fsa, Trigger};
 use super::region::Region;
@@ -222,10 +222,11 @@ impl Docking {
     }
 
     /// A constrained Hough request for the dock believed `d` from its face: five scale
-    /// hypotheses over the distances the belief allows (004 §4.2.2).
+    /// hypotheses over the distances the belief allows (004 §4.1.2: "generated from the
+    /// expectations of scale ... as constrained by the uncertainty in the robot's position").
     fn hough_request(&mut self, now: u64, d: f64) -> VisionRequest {
         let unit = self.focal_px * self.g.frame_width_m / 2.0;
-        let (far, near) = (d + self.g.hough_range_sd_m, (d - self.g.hough_range_sd_m).max(0.5));
+        let (near, far) = hough_band(&self.g, self.region.as_ref(), d);
         let min = self.g.hough_min_certainty as f32;
         let params = [(unit / far) as f32, (unit / near) as f32, 5.0, 0.0, min, 0.0, 0.0, 0.0];
         self.seq.request(now, VisionAlgorithm::Dock, [0.0; 4], params)

@@ -39,6 +39,13 @@ impl Region {
         let off = wrap(p.heading_rad - self.heading_rad);
         inside && (-self.cw_rad - margin_rad..=self.ccw_rad + margin_rad).contains(&off)
     }
+
+    /// The least and greatest of `f` over the region (a linear `f`'s extremes over a convex
+    /// polygon are at its vertices).
+    pub fn span(&self, f: impl Fn([f64; 2]) -> f64) -> (f64, f64) {
+        let values = self.polygon.iter().map(|&v| f(v));
+        values.fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x), hi.max(x)))
+    }
 }
 
 #[cfg(test)]
@@ -73,5 +80,7 @@ mod tests {
         assert!(r.admits(&pose(8.0, 0.0, 22.0), 0.0, 0.1));
         assert!(!r.admits(&pose(8.0, 0.0, 25.0), 0.0, 0.1));
         assert_eq!(Region::of(&UncertaintyMap::default()), None, "no polygon, no region");
+        assert_eq!(r.span(|p| p[0] - 10.0), (-3.0, -1.0));
+        assert_eq!(r.span(|p| 0.5 * p[1]), (-0.5, 0.5));
     }
 }

@@ -65,6 +65,11 @@ pub struct DockingGoal {
     pub hough_range_m: f64,
     pub hough_range_sd_m: f64,
     pub hough_min_certainty: f64,
+    /// The Hough's scale hypotheses span the distances from the dock's face that the UMS's region
+    /// allows (004 §4.1.2), widened by this either way (m); `hough_range_sd_m` either way of
+    /// the belief while the UMS has published no region.
+    #[serde(default = "default_hough_band_min_m")]
+    pub hough_band_min_m: f64,
     pub retry_after_m: f64,
     /// Tracking steers for the dock's axis this far ahead of the robot (the approach zone), and
     /// hands over to the sonar when the target covers this many pixels.
@@ -294,4 +299,8 @@ pub(crate) fn check_poles(p: &PolesGoal) -> Result<(), &'static str> {
 
 fn default_approach_cone_deg() -> f64 {
     30.0
+}
+
+fn default_hough_band_min_m() -> f64 {
+    0.3
 }
