@@ -179,12 +179,8 @@ mod tests {
         // The dock's face at x = 13.6 facing -x: the region lies 4.6-6.6 m from it.
         assert!(close(hough_band(&g, Some(&region), 5.6), (4.3, 6.9)));
         assert!(close(hough_band(&g, Some(&region), 4.0), (3.7, 6.9)), "the belief outside it counts too");
-        let near = Region::of(&{
-            let mut m = m.clone();
-            m.vertices_m[..4].copy_from_slice(&[[13.0, -0.1], [13.3, -0.1], [13.3, 0.1], [13.0, 0.1]]);
-            m
-        })
-        .expect("a region");
+        m.vertices_m[..4].copy_from_slice(&[[13.0, -0.1], [13.3, -0.1], [13.3, 0.1], [13.0, 0.1]]);
+        let near = Region::of(&m).expect("a region");
         assert!(close(hough_band(&g, Some(&near), 0.4), (0.5, 0.9)), "never nearer than half a metre");
     }
 }
