@@ -1,9 +1,10 @@
 //! Opening a chunk: its records decompressed within limits and checked against the chunk's CRC
 //! before any of them is parsed or handed on. A chunk may claim at most what its compressed bytes
 //! could decompress to (the codec's largest ratio) and never more than [`MAX_CHUNK_BYTES`], so a
-//! flipped bit in a size is an error, not an allocation: a zstd chunk is decompressed in one call
-//! into a buffer of its claimed size only up to 64 MiB (a chunk is ~4 MiB), past that the output
-//! buffer grows with what is actually decompressed, never with what is claimed.
+//! flipped bit in a size is an error that costs at most one allocation of 64 MiB: a zstd chunk
+//! claiming up to that is decompressed in one call into a buffer of its claimed size (a chunk is
+//! ~4 MiB), past that the output buffer grows with what is actually decompressed, never with what
+//! is claimed.
 
 use std::borrow::Cow;
 use std::io::Read;
@@ -78,7 +79,9 @@ impl Unpacker {
 
     /// Takes back the buffer of a chunk's records read out, for the next chunk.
     pub fn give_back(&mut self, records: Vec<u8>) {
-        if records.capacity() > self.spare.capacity() {
+        // A buffer a streamed chunk grew past the one-call limit is not kept.
+        let fits = records.capacity() as u64 <= BULK_MAX_BYTES + 1;
+        if fits && records.capacity() > self.spare.capacity() {
             self.spare = records;
         }
     }
@@ -91,7 +94,7 @@ impl Unpacker {
         }
         let mut out = std::mem::take(&mut self.spare);
         out.clear();
-        out.reserve(claims as usize + 1);
+        out.reserve_exact(claims as usize + 1);
         let zstd = match &mut self.zstd {
             Some(z) => z,
             None => self

@@ -85,6 +85,9 @@ pub(crate) struct Stream<'a> {
     part: Part,
     chunk: Option<Open<'a>>,
     unpacker: chunk::Unpacker,
+    /// Finished chunks some message may still share (a tick's messages outlive their chunk's
+    /// end): reclaimed for the next chunk once none does.
+    retired: Vec<Arc<Vec<u8>>>,
     channels: ChannelAccumulator<'static>,
 }
 
@@ -93,7 +96,7 @@ impl<'a> Stream<'a> {
     pub fn new(bytes: &'a [u8]) -> Self {
         let at = mcap::MAGIC.len();
         let (chunk, unpacker, channels) = (None, chunk::Unpacker::default(), ChannelAccumulator::default());
-        Self { bytes, at, part: Part::Data, chunk, unpacker, channels }
+        Self { bytes, at, part: Part::Data, chunk, unpacker, retired: Vec::new(), channels }
     }
 
     /// The next message of the chunk being read, if it has one left.
@@ -101,10 +104,12 @@ impl<'a> Stream<'a> {
         loop {
             let open = self.chunk.as_mut()?;
             if open.at >= open.records.bytes().len() {
-                if let Some(Open { records: Records::Chunk(done), .. }) = self.chunk.take()
-                    && let Ok(done) = Arc::try_unwrap(done)
-                {
-                    self.unpacker.give_back(done);
+                if let Some(Open { records: Records::Chunk(done), .. }) = self.chunk.take() {
+                    // Two at most: a message kept longer keeps its chunk, not the reader's buffer.
+                    if self.retired.len() == 2 {
+                        self.retired.remove(0);
+                    }
+                    self.retired.push(done);
                 }
                 return None;
             }
@@ -133,6 +138,15 @@ impl<'a> Stream<'a> {
         }
     }
 
+    /// Hands the unpacker back a finished chunk's buffer that no message shares any more.
+    fn reclaim(&mut self) {
+        if let Some(i) = self.retired.iter().position(|c| Arc::strong_count(c) == 1)
+            && let Ok(buffer) = Arc::try_unwrap(self.retired.swap_remove(i))
+        {
+            self.unpacker.give_back(buffer);
+        }
+    }
+
     /// Reads the next top-level record: `Some` with a message or damage, `None` to read on.
     fn step(&mut self) -> Option<Result<Linked<'a>, Located>> {
         let at = self.at;
@@ -149,6 +163,7 @@ impl<'a> Stream<'a> {
         match (self.part, raw.opcode) {
             (Part::Data, op::CHUNK) => match raw.parse() {
                 Ok(Record::Chunk { header, data }) => {
+                    self.reclaim();
                     let opened = match data {
                         Cow::Borrowed(data) => self.unpacker.open(&header, data),
                         Cow::Owned(data) => self.unpacker.open(&header, &data).map(chunk::Opened::into_owned),
@@ -310,6 +325,24 @@ mod tests {
             .collect();
         assert_eq!(ours.len(), 80);
         assert_eq!(ours, theirs);
+        // Read as a replay reads: the last message kept while the next is read, across chunk
+        // ends. The bytes are the same, and a finished chunk's buffer still comes back for
+        // the chunks after it.
+        let mut kept: Option<Linked<'_>> = None;
+        let mut buffers = Vec::new();
+        for (k, m) in Stream::new(&bytes).enumerate() {
+            let m = m.expect("intact");
+            assert_eq!(m.data.bytes(), &theirs[k].3[..]);
+            if let Payload::Chunk(chunk, _) = &m.data
+                && buffers.last() != Some(&(chunk.as_ptr() as usize))
+            {
+                buffers.push(chunk.as_ptr() as usize);
+            }
+            kept = Some(m);
+        }
+        drop(kept);
+        assert_eq!(buffers.len(), 4, "four chunks");
+        assert_eq!(buffers[2], buffers[0], "the third chunk in the first one's buffer: {buffers:?}");
         std::fs::remove_dir_all(&dir).ok();
     }
 }

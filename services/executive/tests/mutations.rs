@@ -65,6 +65,7 @@ const POSITIVE: &[&str] = &[
 /// levels, fractions, schema gains, waits, tick counts.
 const NON_NEGATIVE: &[&str] = &[
     "hough_range_sd_m",
+    "hough_band_min_m",
     "fix_beyond_m",
     "too_close_m",
     "frame_height_m",

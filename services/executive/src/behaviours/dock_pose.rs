@@ -97,6 +97,12 @@ pub(crate) fn hough_band(g: &DockingGoal, region: Option<&Region>, d: f64) -> (f
         }
         None => (d - g.hough_range_sd_m, d + g.hough_range_sd_m),
     };
+    // A region that does not give a band (a vertex not finite) falls back to the paper's spread.
+    let (near, far) = if near.is_finite() && far.is_finite() && near <= far {
+        (near, far)
+    } else {
+        (d - g.hough_range_sd_m, d + g.hough_range_sd_m)
+    };
     // Nearer than half a metre the frame is far wider than the image.
     (near.max(0.5), far.max(0.5))
 }
@@ -182,5 +188,11 @@ mod tests {
         m.vertices_m[..4].copy_from_slice(&[[13.0, -0.1], [13.3, -0.1], [13.3, 0.1], [13.0, 0.1]]);
         let near = Region::of(&m).expect("a region");
         assert!(close(hough_band(&g, Some(&near), 0.4), (0.5, 0.9)), "never nearer than half a metre");
+        m.vertices_m[0] = [f64::INFINITY, 0.0];
+        let broken = Region::of(&m).expect("a region");
+        assert!(
+            close(hough_band(&g, Some(&broken), 5.6), (5.6 - 1.22, 5.6 + 1.22)),
+            "not finite: the paper's"
+        );
     }
 }

@@ -227,6 +227,9 @@ impl Docking {
     fn hough_request(&mut self, now: u64, d: f64) -> VisionRequest {
         let unit = self.focal_px * self.g.frame_width_m / 2.0;
         let (near, far) = hough_band(&self.g, self.region.as_ref(), d);
+        // The vision workers take a frame's half width of 2 to 1000 px: a band past that asks
+        // for scales no dock in the image can have.
+        let (near, far) = (near.max(unit / 999.0), far.min(unit / 2.0).max(near.max(unit / 999.0)));
         let min = self.g.hough_min_certainty as f32;
         let params = [(unit / far) as f32, (unit / near) as f32, 5.0, 0.0, min, 0.0, 0.0, 0.0];
         self.seq.request(now, VisionAlgorithm::Dock, [0.0; 4], params)

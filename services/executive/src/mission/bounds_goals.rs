@@ -90,7 +90,7 @@ pub(crate) fn check_docking(k: &KeyPath, d: &DockingGoal) -> Result<(), OutOfRan
     check(&k.key("hough_range_m"), d.hough_range_m, &LENGTH)?;
     check(&k.key("hough_range_sd_m"), d.hough_range_sd_m, &LENGTH_OR_ZERO)?;
     check(&k.key("hough_min_certainty"), d.hough_min_certainty, &FRACTION)?;
-    check(&k.key("hough_band_min_m"), d.hough_band_min_m, &LENGTH_OR_ZERO)?;
+    check(&k.key("hough_band_min_m"), d.hough_band_min_m, &Range::closed(0.0, 5.0, "m"))?;
     check(&k.key("retry_after_m"), d.retry_after_m, &LENGTH)?;
     check(&k.key("lead_m"), d.lead_m, &LENGTH)?;
     check(&k.key("keep_in_view_deg"), d.keep_in_view_deg, &HALF_TURN)?;
