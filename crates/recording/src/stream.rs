@@ -44,20 +44,17 @@ impl Records<'_> {
     }
 }
 
-/// A message's payload: bytes of the file, or a range of the decompressed chunk it came in
-/// (shared, not copied out).
+/// A message's payload: its range of the records it lies in (the file's, or its chunk's, shared
+/// rather than copied out).
 #[derive(Debug, Clone)]
-pub(crate) enum Payload<'a> {
-    File(&'a [u8]),
-    Chunk(Arc<Vec<u8>>, Range<usize>),
+pub(crate) struct Payload<'a> {
+    records: Records<'a>,
+    range: Range<usize>,
 }
 
 impl Payload<'_> {
     pub fn bytes(&self) -> &[u8] {
-        match self {
-            Payload::File(b) => b,
-            Payload::Chunk(chunk, range) => &chunk[range.clone()],
-        }
+        &self.records.bytes()[self.range.clone()]
     }
 }
 
@@ -126,11 +123,7 @@ impl<'a> Stream<'a> {
             }
             match take(&mut self.channels, raw) {
                 Ok(Some((m, range))) => {
-                    let data = match &open.records {
-                        Records::File(b) => Payload::File(&b[range]),
-                        Records::Chunk(b) => Payload::Chunk(Arc::clone(b), range),
-                    };
-                    return Some(Ok(m.with(data)));
+                    return Some(Ok(m.with(Payload { records: open.records.clone(), range })));
                 }
                 Ok(None) => {}
                 Err(what) => return Some(Err(in_chunk(what))),
@@ -196,7 +189,9 @@ impl<'a> Stream<'a> {
                 Err(what) => here(what),
             },
             (Part::Data, _) => match take(&mut self.channels, raw) {
-                Ok(Some((m, range))) => Some(Ok(m.with(Payload::File(&self.bytes[range])))),
+                Ok(Some((m, range))) => {
+                    Some(Ok(m.with(Payload { records: Records::File(self.bytes), range })))
+                }
                 Ok(None) => None,
                 Err(what) => here(what),
             },
@@ -333,7 +328,7 @@ mod tests {
         for (k, m) in Stream::new(&bytes).enumerate() {
             let m = m.expect("intact");
             assert_eq!(m.data.bytes(), &theirs[k].3[..]);
-            if let Payload::Chunk(chunk, _) = &m.data
+            if let Records::Chunk(chunk) = &m.data.records
                 && buffers.last() != Some(&(chunk.as_ptr() as usize))
             {
                 buffers.push(chunk.as_ptr() as usize);
