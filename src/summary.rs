@@ -47,6 +47,9 @@ pub struct RunStats {
     pub line_offset_m: Option<f64>,
     /// Each pose fix's distance from the true pose when its frames were taken (metres).
     pub fix_errors_m: Vec<f64>,
+    /// The UMS's maps that do not hold the true pose at their stamp, and the maps checked
+    /// (those with a true pose at or before them); `None` without both topics.
+    pub ums_truth: Option<(usize, usize)>,
 }
 
 /// A run's figures as data (`harvey sweep` tabulates them): the numbers the mission summary
@@ -67,6 +70,21 @@ pub struct Figures {
     /// The acceptor's states (empty without a sequenced behaviour) and what it achieved.
     pub trace: Vec<u32>,
     pub achieved: u32,
+    /// The UMS's maps without the true pose, of the maps checked.
+    pub ums_truth: Option<(usize, usize)>,
+}
+
+/// How far outside a map the truth may lie and still count as held (metres): rounding.
+const HOLDS_TOL_M: f64 = 1e-6;
+
+/// The maps that do not hold the true pose at or just before their stamp, and the maps checked;
+/// `None` without maps or without a true pose.
+fn ums_truth(maps: &[UncertaintyMap], truth: &mut [(u64, harvey_msgs::Pose2)]) -> Option<(usize, usize)> {
+    truth.sort_by_key(|(t, _)| *t);
+    let at = |stamp: u64| truth[..truth.partition_point(|(t, _)| *t <= stamp)].last().map(|(_, p)| *p);
+    let checked: Vec<bool> =
+        maps.iter().filter_map(|m| at(m.header.stamp_ns).map(|p| m.holds(&p, HOLDS_TOL_M))).collect();
+    (!checked.is_empty()).then(|| (checked.iter().filter(|h| !**h).count(), checked.len()))
 }
 
 impl RunStats {
@@ -74,6 +92,8 @@ impl RunStats {
         let recording = Recording::open(path)?;
         let mut run = RunStats::default();
         let mut true_path: Vec<(f64, [f64; 2])> = Vec::new();
+        let mut true_poses: Vec<(u64, harvey_msgs::Pose2)> = Vec::new();
+        let mut maps: Vec<UncertaintyMap> = Vec::new();
         // The line of `line_offset_m`: the first true pose's x, y, cos and sin of its heading.
         let mut line: Option<[f64; 4]> = None;
         let mut fixes: Vec<PoseFix> = Vec::new();
@@ -93,6 +113,7 @@ impl RunStats {
                     let t: TruePose = m.decode()?;
                     let p = t.world_from_robot;
                     true_path.push((t.header.stamp_ns as f64 / 1e9, [p.x_m, p.y_m]));
+                    true_poses.push((t.header.stamp_ns, p));
                     let [x0, y0, c, s] = *line.get_or_insert_with(|| {
                         let (s, c) = p.heading_rad.sin_cos();
                         [p.x_m, p.y_m, c, s]
@@ -101,7 +122,11 @@ impl RunStats {
                     run.line_offset_m = Some(run.line_offset_m.map_or(off, |m: f64| m.max(off)));
                     run.last_truth = Some(t);
                 }
-                "ums/map" => run.last_map = Some(m.decode()?),
+                "ums/map" => {
+                    let map: UncertaintyMap = m.decode()?;
+                    maps.push(map);
+                    run.last_map = Some(map);
+                }
                 "executive/pose" => {
                     run.fixes += 1;
                     fixes.push(m.decode::<PoseFix>()?);
@@ -136,6 +161,7 @@ impl RunStats {
                 run.fix_errors_m.push((f.refined.x_m - x).hypot(f.refined.y_m - y));
             }
         }
+        run.ums_truth = ums_truth(&maps, &mut true_poses);
         match recording.world() {
             Ok(Some((w, poles))) => {
                 if let Some(f) = w.poles.as_ref() {
@@ -186,6 +212,7 @@ impl RunStats {
             fix_error_m: self.fix_errors_m.iter().copied().reduce(f64::max),
             trace: self.fsa_trace.clone(),
             achieved: self.achieved,
+            ums_truth: self.ums_truth,
             ..Figures::default()
         };
         if let (Some(s), Some(t), None) = (&self.last_status, &self.last_truth, &self.pole_visits) {
@@ -246,6 +273,9 @@ impl RunStats {
                 wedge,
                 if m.lost == 1 { ", LOST" } else { "" }
             );
+        }
+        if let Some((without, of)) = self.ums_truth {
+            out += &format!("  the true pose inside the uncertainty map: {} of {of} maps\n", of - without);
         }
         if self.last_plan.is_some() {
             let [reached, retried, replanned] = self.checks;

@@ -211,17 +211,8 @@ pub fn run_mission_under(mission: &str, condition: &str, seed: u64, tag: &str) -
 
 /// Whether the map holds a pose: inside its convex polygon (with `tol`) and its heading wedge.
 pub fn holds(m: &harvey_msgs::UncertaintyMap, x: f64, y: f64, th: f64, tol: f64) -> bool {
-    let n = m.vertex_count as usize;
-    let v = &m.vertices_m[..n];
-    let inside = n < 3
-        || (0..n).all(|i| {
-            let (a, b) = (v[i], v[(i + 1) % n]);
-            let cross = (b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0]);
-            cross / (b[0] - a[0]).hypot(b[1] - a[1]) >= -tol
-        });
-    let d = (th - m.centre.heading_rad + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
-        - std::f64::consts::PI;
-    inside && d >= -m.heading_cw_rad - 1e-9 && d <= m.heading_ccw_rad + 1e-9
+    // A map of fewer than three vertices (the exact start) is not checked here.
+    m.vertex_count < 3 || m.holds(&harvey_msgs::Pose2 { x_m: x, y_m: y, heading_rad: th }, tol)
 }
 
 /// `harvey replay --check` of `recording`, under its own bus prefix and scratch run folder.

@@ -7,6 +7,7 @@
 
 mod executive;
 mod frame;
+mod holds;
 mod log;
 mod payloads;
 pub mod topics;
