@@ -94,8 +94,9 @@ def opencv_case(kernel, img, win, tmpl):
 
 
 # Kernels on frame pairs (stereo, depth from motion: the bench exports one frame) or on line
-# lists (the dock Hough, path grouping: the line finder's row already compares LSD).
-NO_COUNTERPART = ("stereo", "depth from motion", "constrained Hough", "path following")
+# lists (the dock Hough, path grouping: the line finder's row already compares LSD), or on two
+# stops of a stereo pair (visual odometry).
+NO_COUNTERPART = ("stereo", "depth from motion", "constrained Hough", "path following", "visual odometry")
 
 
 def main():
