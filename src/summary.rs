@@ -77,11 +77,11 @@ pub struct Figures {
 /// How far outside a map the truth may lie and still count as held (metres): rounding.
 const HOLDS_TOL_M: f64 = 1e-6;
 
-/// The maps that do not hold the true pose at or just before their stamp, and the maps checked;
-/// `None` without maps or without a true pose.
+/// The maps that do not hold the true pose of their stamp, and the maps checked (those with a
+/// true pose of the same stamp: both are stamped on the simulator's ticks); `None` without such.
 fn ums_truth(maps: &[UncertaintyMap], truth: &mut [(u64, harvey_msgs::Pose2)]) -> Option<(usize, usize)> {
     truth.sort_by_key(|(t, _)| *t);
-    let at = |stamp: u64| truth[..truth.partition_point(|(t, _)| *t <= stamp)].last().map(|(_, p)| *p);
+    let at = |stamp: u64| truth.binary_search_by_key(&stamp, |(t, _)| *t).ok().map(|k| truth[k].1);
     let checked: Vec<bool> =
         maps.iter().filter_map(|m| at(m.header.stamp_ns).map(|p| m.holds(&p, HOLDS_TOL_M))).collect();
     (!checked.is_empty()).then(|| (checked.iter().filter(|h| !**h).count(), checked.len()))

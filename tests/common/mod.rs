@@ -211,8 +211,14 @@ pub fn run_mission_under(mission: &str, condition: &str, seed: u64, tag: &str) -
 
 /// Whether the map holds a pose: inside its convex polygon (with `tol`) and its heading wedge.
 pub fn holds(m: &harvey_msgs::UncertaintyMap, x: f64, y: f64, th: f64, tol: f64) -> bool {
-    // A map of fewer than three vertices (the exact start) is not checked here.
-    m.vertex_count < 3 || m.holds(&harvey_msgs::Pose2 { x_m: x, y_m: y, heading_rad: th }, tol)
+    // A map of fewer than three vertices (the exact start) is held to its heading only: as a
+    // point where the pose stands.
+    let mut m = *m;
+    if m.vertex_count < 3 {
+        m.vertex_count = 1;
+        m.vertices_m[0] = [x, y];
+    }
+    m.holds(&harvey_msgs::Pose2 { x_m: x, y_m: y, heading_rad: th }, tol)
 }
 
 /// `harvey replay --check` of `recording`, under its own bus prefix and scratch run folder.
