@@ -85,7 +85,7 @@ fn rust_layouts() -> Vec<Value> {
             reserved
         }),
         layout!(LandmarkSighting { header, frame_seq, landmark_index, kind, a, a_sd, b, b_sd }),
-        layout!(Expectation { header, landmark_index, class, window_px, width_px, height_px }),
+        layout!(Expectation { header, landmark_index, class, window_px, width_px, height_px, contrast }),
         layout!(MissionStatus {
             header,
             state,

@@ -274,6 +274,10 @@ pub struct Expectation {
     pub window_px: [f32; 4],
     pub width_px: u32,
     pub height_px: u32,
+    /// A class I landmark's look, as the map predicts it from the believed pose: the step in
+    /// reflectance across its line, right side less left, in four equal bands of the window's
+    /// rows, top first (`harvey_render::edge_contrast`). All 0: no prediction.
+    pub contrast: [f32; 4],
 }
 message!(Expectation);
 

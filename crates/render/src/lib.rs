@@ -3,9 +3,11 @@
 //! loaned shared-memory slice); `Shooter` a whole frame, one camera's or a stereo pair's.
 
 mod blur;
+mod contrast;
 mod effects;
 mod shot;
 
+pub use contrast::{CONTRAST_BANDS, edge_contrast};
 pub use effects::{Effects, mount_error};
 use harvey_msgs::Encoding;
 use harvey_world::{Pose2, World};

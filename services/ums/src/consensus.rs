@@ -35,9 +35,42 @@ fn radius(map: &Map) -> f64 {
     map.polygon.iter().map(|p| (p[0] - map.centre[0]).hypot(p[1] - map.centre[1])).fold(0.0, f64::max)
 }
 
-/// The indices into `group` (sightings of one frame) that disagree with the rest; empty with
-/// fewer than three bearings, where a majority cannot be told.
+/// The indices into `group` (sightings of one frame) that disagree with the rest, and every
+/// pair of different landmarks seen on one edge (`same_edge`); the majority is told from three
+/// bearings on.
 pub fn outliers(world: &World, map: &Map, group: &[LandmarkSighting], sigmas: f64) -> Vec<usize> {
+    let mut out = same_edge(group);
+    for i in majority(world, map, group, sigmas) {
+        if !out.contains(&i) {
+            out.push(i);
+        }
+    }
+    out
+}
+
+/// One edge, one landmark: two landmarks' bearings in one frame within a fifth of the sharper
+/// one's spread (a fraction of a pixel) are one edge two windows took, a look-alike for one of
+/// them at least, which of them the frame cannot tell: both indices, in `group`'s order.
+fn same_edge(group: &[LandmarkSighting]) -> Vec<usize> {
+    let bearing = |s: &LandmarkSighting| {
+        matches!(SightingKind::from_raw(s.kind), Some(SightingKind::Bearing | SightingKind::BearingRange))
+    };
+    (0..group.len())
+        .filter(|&i| {
+            let a = &group[i];
+            bearing(a)
+                && group.iter().any(|b| {
+                    bearing(b)
+                        && b.landmark_index != a.landmark_index
+                        && harvey_geometry::wrap(a.a - b.a).abs() < 0.2 * a.a_sd.min(b.a_sd)
+                })
+        })
+        .collect()
+}
+
+/// The indices into `group` whose implied heading disagrees with the others' median; empty
+/// with fewer than three bearings, where a majority cannot be told.
+fn majority(world: &World, map: &Map, group: &[LandmarkSighting], sigmas: f64) -> Vec<usize> {
     // (index, implied heading, (its spread, the shift the map's spread may give it))
     let mut implied: Vec<(usize, f64, (f64, f64))> = Vec::new();
     // How far the map's own spread of positions moves a bearing: its farthest vertex.
@@ -123,5 +156,28 @@ mod tests {
         let mirrored = Map { cw_rad: 0.06, ccw_rad: 0.001, ..known };
         assert!(implausible(&w, &mirrored, &short, 3.0));
         assert!(!implausible(&w, &mirrored, &frame[2], 3.0));
+    }
+
+    #[test]
+    fn two_landmarks_on_one_edge_are_both_refused() {
+        let w =
+            harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("loads");
+        let map = Map::exact(0.0, 0.0, 0.0);
+        let at = |i: u32, a: f64| LandmarkSighting {
+            header: Header::new(1, 100),
+            landmark_index: i,
+            kind: SightingKind::Bearing as u32,
+            a,
+            a_sd: 0.004,
+            ..Default::default()
+        };
+        // The end-wall corner's window held the office door's jamb: both on the same column,
+        // the jamb's sighting right, the corner's 37 mrad off. Two: no majority, both refused.
+        let (jamb, corner) = (at(2, 0.0379), at(5, 0.0379 + 0.0002));
+        assert_eq!(outliers(&w, &map, &[jamb, corner], 3.0), vec![0, 1]);
+        // A pixel apart (1.8 mrad at 554 px): two edges.
+        assert!(outliers(&w, &map, &[jamb, at(5, 0.0379 + 0.0018)], 3.0).is_empty());
+        // The same landmark twice (two recognisers) is not two landmarks.
+        assert!(outliers(&w, &map, &[jamb, at(2, 0.0379)], 3.0).is_empty());
     }
 }

@@ -346,6 +346,11 @@ impl Ums {
                     window_px: [win.u0 as f32, win.v0 as f32, win.u1 as f32, win.v1 as f32],
                     width_px: w,
                     height_px: h,
+                    contrast: if class == 1 {
+                        expecter::look(&self.world, m, (w, h), l, &win)
+                    } else {
+                        [0.0; 4]
+                    },
                 })
             })
             .collect()

@@ -43,6 +43,12 @@ pub struct LineLandmarks {
     /// An edge's strength must be this many of its noise deviations (the window's sensor
     /// noise averaged over a band, then over the bands) clear of zero.
     pub z: f32,
+    /// An edge whose agreement with the predicted look (`Profile::agreement`, -1 to 1) is
+    /// below the negative of this runs the other way from the landmark: not taken, no rival.
+    pub contrary: f32,
+    /// The least mean predicted step (reflectance, over the look's bands) for the look to be
+    /// used: a tenth of the scale, 22 grey levels in full light, about the edge threshold.
+    pub clear_look: f32,
     profile: Profile,
     peaks: Vec<(usize, f32)>,
     seq: u64,
@@ -74,6 +80,8 @@ impl LineLandmarks {
             span_px: 1,
             band_rows: 8,
             z: 6.0,
+            contrary: 0.5,
+            clear_look: 0.1,
             profile: Profile::default(),
             peaks: Vec::new(),
             seq: 0,
@@ -130,6 +138,17 @@ impl LineLandmarks {
         let threshold = (self.threshold * (mean / 128.0).clamp(0.1, 1.0)).max(noise);
         // Every edge that could make the answer ambiguous, those under the threshold too.
         self.find_peaks((threshold / self.dominance).max(noise), span);
+        // An edge stepping the other way from the look the map predicts, clearly, is another
+        // edge (a look-alike: the next door's other jamb). Where the landmark's own step is
+        // predicted clear, it is neither the landmark nor its rival; beside a faint landmark
+        // it stays a rival (the landmark may be too faint to see, and the look-alike left the
+        // only edge of the right polarity in the window) but is never taken.
+        let predicted = e.contrast.iter().map(|c| c.abs()).sum::<f32>() / e.contrast.len() as f32;
+        let contrary = |profile: &Profile, k| profile.agreement(k, span, &e.contrast) < -self.contrary;
+        if predicted >= self.clear_look {
+            let profile = &self.profile;
+            self.peaks.retain(|&(k, _)| !contrary(profile, k));
+        }
         // Numbered only when sent, so that a gap in `seq` means a lost message.
         let header = Header::new(self.seq + 1, h.stamp_ns);
         let base = LandmarkSighting {
@@ -145,7 +164,9 @@ impl LineLandmarks {
         };
         // Another edge of like strength, not the same one's plateau (a sharp edge is `span`
         // columns wide in the profile): ambiguous.
-        if self.peaks.iter().any(|&(j, s)| j.abs_diff(k) > span && s * self.dominance > strength) {
+        if self.peaks.iter().any(|&(j, s)| j.abs_diff(k) > span && s * self.dominance > strength)
+            || (predicted > 0.0 && contrary(&self.profile, k))
+        {
             return None;
         }
         let u_edge = (u0 + 1) as f64 + self.profile.edge_at(k, span);
@@ -227,6 +248,25 @@ mod tests {
         assert_eq!(s.kind, SightingKind::Bearing as u32);
         let other_size = Expectation { width_px: 640, ..expect(30.0, 50.0) };
         assert!(r.recognise(&h, &frame(&[]), &other_size).is_none());
+    }
+
+    #[test]
+    fn the_predicted_look_tells_the_landmark_from_a_look_alike_stepping_the_other_way() {
+        // A bright door between columns 35 and 45: its two jambs step opposite ways, alike in
+        // strength, so without a prediction the window is ambiguous.
+        let h = FrameHeader::new(1, 0, 64, 48, Encoding::Mono8);
+        let f = frame(&[(35, 200), (45, 50)]);
+        let mut r = LineLandmarks::new(55.4, 10.0);
+        assert!(r.recognise(&h, &f, &expect(25.0, 55.0)).is_none(), "ambiguous");
+        for (contrast, column) in [(0.4, 35.0), (-0.4, 45.0)] {
+            let e = Expectation { contrast: [contrast; 4], ..expect(25.0, 55.0) };
+            let s = r.recognise(&h, &f, &e).expect("an answer");
+            assert_eq!(s.kind, SightingKind::Bearing as u32);
+            assert!((s.a - bearing(column)).abs() < 1e-9, "{contrast}: {} for {column}", s.a);
+        }
+        // Only the look-alike in the window: not found, never taken for the landmark.
+        let e = Expectation { contrast: [0.4; 4], ..expect(40.0, 55.0) };
+        assert_eq!(r.recognise(&h, &f, &e).expect("an answer").kind, SightingKind::NotFound as u32);
     }
 
     #[test]

@@ -77,6 +77,7 @@ fn every_message_round_trips() {
         window_px: [1.0, 2.0, 30.0, 40.0],
         width_px: 640,
         height_px: 480,
+        contrast: [0.5, -0.25, 0.0, 0.125],
     });
     round_trip(MissionStatus { header: h, state: 1, goal: pose, maps_seen: 3, ..Default::default() });
 }

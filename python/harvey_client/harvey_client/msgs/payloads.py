@@ -141,6 +141,7 @@ class Expectation(Message):
         ("window_px", c_f32 * 4),
         ("width_px", c_u32),
         ("height_px", c_u32),
+        ("contrast", c_f32 * 4),
     ]
     _type_name = "harvey_msgs/Expectation"
 

@@ -115,6 +115,24 @@ impl Profile {
         present as f32 / self.bands as f32
     }
 
+    /// How the ramp from `k` to `k + span` agrees with a predicted look (`contrast`: the step
+    /// right less left in equal bands of the window's rows, top first), from -1 to 1: each
+    /// band's signed step weighed by the prediction for the rows it lies in, summed, over the
+    /// same of their magnitudes. -1: the edge runs the other way from the landmark's in every
+    /// band the prediction weighs (a look-alike); 0 where nothing is predicted.
+    pub fn agreement(&self, k: usize, span: usize, contrast: &[f32]) -> f32 {
+        let parts = contrast.len() as f32;
+        let (along, all) = (0..self.bands)
+            .map(|b| {
+                let part = ((b as f32 + 0.5) / self.bands as f32 * parts) as usize;
+                let l = self.band(b);
+                let (c, step) = (contrast[part.min(contrast.len() - 1)], l[k + span] - l[k]);
+                (c * step, (c * step).abs())
+            })
+            .fold((0.0, 0.0), |(a, m), (x, y)| (a + x, m + y));
+        if all > 0.0 { along / all } else { 0.0 }
+    }
+
     /// Where the edge whose ramp starts at column `k` lies, in columns from the window's first
     /// boundary (the one between its columns 0 and 1): the centroid of the single-column steps
     /// along each band's ramp direction, each less a quarter of the largest (a sharp edge:
@@ -165,6 +183,30 @@ mod tests {
         p.fill(&f, 8, 1, [0, 0, 8, 32], 32);
         p.strengths(1, 0.0);
         assert_eq!(p.strength[3], 0.0);
+    }
+
+    #[test]
+    fn an_edge_agrees_with_the_look_predicted_for_it_not_with_the_reverse() {
+        // 8 columns, 32 rows: a rise at column 4 in the top half, a fall in the bottom half.
+        let f: Vec<u8> = (0..8 * 32)
+            .map(|i| {
+                if i % 8 < 4 {
+                    100
+                } else if i / 8 < 16 {
+                    130
+                } else {
+                    90
+                }
+            })
+            .collect();
+        let mut p = Profile::default();
+        p.fill(&f, 8, 1, [0, 0, 8, 32], 8);
+        assert_eq!(p.agreement(3, 1, &[0.3, 0.3, -0.1, -0.1]), 1.0);
+        assert_eq!(p.agreement(3, 1, &[-0.3, -0.3, 0.1, 0.1]), -1.0);
+        // Weighed by the prediction: a strong rise predicted above outweighs a weak fall below
+        // ((18 - 2) / (18 + 2)).
+        assert!((p.agreement(3, 1, &[0.3, 0.3, 0.1, 0.1]) - 0.8).abs() < 1e-6);
+        assert_eq!(p.agreement(3, 1, &[0.0; 4]), 0.0);
     }
 
     #[test]

@@ -300,7 +300,7 @@ mod tests {
         (
             "ums/expectations",
             "harvey_msgs/msg/Expectation",
-            "RIHS01_61859a56f62bb126e58a424a81ffe1ad929c22b8592eb0b4a1da79fff3a8589b",
+            "RIHS01_47c626a1b118e5e835a17fc67ca9c407eeff27ffc0618c1d987e69d48d731d27",
         ),
         (
             "executive/status",
