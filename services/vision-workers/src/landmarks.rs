@@ -44,7 +44,8 @@ pub struct LineLandmarks {
     /// noise averaged over a band, then over the bands) clear of zero.
     pub z: f32,
     /// An edge whose agreement with the predicted look (`Profile::agreement`, -1 to 1) is
-    /// below the negative of this runs the other way from the landmark: not taken, no rival.
+    /// below the negative of this runs the other way from the landmark: never taken, and no
+    /// rival where the look is clear (`clear_look`).
     pub contrary: f32,
     /// The least mean predicted step (reflectance, over the look's bands) for the look to be
     /// used: a tenth of the scale, 22 grey levels in full light, about the edge threshold.

@@ -24,7 +24,7 @@ struct Tally {
 /// Looks down the hall from poses along it, each class I landmark in view searched for in a
 /// window from `window_px[0]` to `window_px[1]` columns from its true one; with `look`, the
 /// window carries the landmark's look as an Expecter predicts it from a believed pose 5 cm
-/// ahead, 5 cm to the left and 1 degree to the left of the true one.
+/// further along x and y (the hall's length and width) and 1 degree to the left of the true one.
 fn tally(condition: (&str, f64, f64, f64, u32), seed: u64, window_px: [f64; 2], look: bool) -> Tally {
     let (w, mut r, fx, mut px) = lit(condition, seed, false);
     let (width, height) = SIZE;
@@ -142,7 +142,7 @@ fn the_landmarks_are_found_where_they_are_whatever_the_light() {
                 beside = [beside[0] + plain.1, beside[1] + look.1];
             }
         }
-        // Beside the landmark, the look refuses a third of the edges taken for it, or more.
+        // Beside the landmark, the look refuses a quarter of the edges taken for it, or more.
         assert!(
             beside[1] <= 0.75 * beside[0],
             "{}: beside, {:.1} % with the look, {:.1} % without",

@@ -158,20 +158,25 @@ impl Profile {
 mod tests {
     use super::*;
 
-    #[test]
-    fn a_jamb_whose_contrast_flips_along_its_height_is_still_an_edge() {
-        // 8 columns, 32 rows: above row 16 the edge at column 4 is +30, below it -30.
-        let f: Vec<u8> = (0..8 * 32)
+    /// 8 columns, 32 rows of 100 left of column 4; right of it 130 above row 16, `below` under.
+    fn flipping(below: u8) -> Vec<u8> {
+        (0..8 * 32)
             .map(|i| {
                 if i % 8 < 4 {
                     100
                 } else if i / 8 < 16 {
                     130
                 } else {
-                    70
+                    below
                 }
             })
-            .collect();
+            .collect()
+    }
+
+    #[test]
+    fn a_jamb_whose_contrast_flips_along_its_height_is_still_an_edge() {
+        // Above row 16 the edge at column 4 is +30, below it -30.
+        let f = flipping(70);
         let mut p = Profile::default();
         let (mean, rows_per_band) = p.fill(&f, 8, 1, [0, 0, 8, 32], 16);
         assert_eq!((mean, rows_per_band), (100.0, 16.0));
@@ -187,18 +192,8 @@ mod tests {
 
     #[test]
     fn an_edge_agrees_with_the_look_predicted_for_it_not_with_the_reverse() {
-        // 8 columns, 32 rows: a rise at column 4 in the top half, a fall in the bottom half.
-        let f: Vec<u8> = (0..8 * 32)
-            .map(|i| {
-                if i % 8 < 4 {
-                    100
-                } else if i / 8 < 16 {
-                    130
-                } else {
-                    90
-                }
-            })
-            .collect();
+        // A rise at column 4 in the top half, a fall in the bottom half.
+        let f = flipping(90);
         let mut p = Profile::default();
         p.fill(&f, 8, 1, [0, 0, 8, 32], 8);
         assert_eq!(p.agreement(3, 1, &[0.3, 0.3, -0.1, -0.1]), 1.0);
