@@ -35,9 +35,19 @@ fn printed(stderr: &str) -> Vec<(String, LogLevel, String)> {
 
 #[test]
 fn every_warning_a_service_printed_is_on_rosout_once_stamped_with_a_tick() {
-    // ptrans in the shipped (nominal) world: the UMS refuses false matches (one of them 140
-    // frames in a row) and the executive relocates when the UMS reports the robot lost.
-    let run = common::run_mission_processes("missions/ptrans.toml", "rosout");
+    // ptrans in the shipped (nominal) world, seed 2: the UMS refuses false matches (two of them
+    // nine frames in a row) and the executive relocates when the UMS reports the robot lost.
+    // (Seed 1 no longer gives the UMS a false match to refuse since the expectations carry the
+    // landmarks' look.)
+    let world = common::repo().join("worlds/hallway.toml");
+    let mission = std::fs::read_to_string(common::repo().join("missions/ptrans.toml"))
+        .expect("ptrans")
+        .replace("seed = 1", "seed = 2")
+        .replace("../worlds/hallway.toml", world.to_str().expect("utf8"));
+    let dir = common::scratch("rosout-seed");
+    let file = dir.join("ptrans-seed2.toml");
+    std::fs::write(&file, mission).expect("written");
+    let run = common::run_mission_processes(file.to_str().expect("utf8"), "rosout");
     assert!(run.status.success(), "{}\n{}", run.stdout, run.stderr);
     let (mut lines, mut ticks) = (Vec::new(), std::collections::BTreeSet::new());
     for m in mcap::MessageStream::new(&run.mcap).expect("mcap") {
