@@ -57,14 +57,7 @@ fn the_same_seed_records_the_same_messages_and_another_seed_does_not() {
     let n = agreed(&same);
     assert!(n > 6000, "only {n} messages compared");
 
-    let world = common::repo().join("worlds/hallway.toml");
-    let seeded = std::fs::read_to_string(&default)
-        .expect("default mission")
-        .replace("seed = 1", "seed = 2")
-        .replace("../worlds/hallway.toml", world.to_str().expect("utf8"));
-    let seed_dir = common::scratch("det-seed");
-    let file = seed_dir.join("seed2.toml");
-    std::fs::write(&file, seeded).expect("written");
+    let (_seed_dir, file) = common::at_seed(&default, 2, "det-seed");
     let c_dir = run(&file, "det-c");
     let c = c_dir.join("run.mcap");
     let other = diff(&a, &c);

@@ -39,14 +39,7 @@ fn every_warning_a_service_printed_is_on_rosout_once_stamped_with_a_tick() {
     // nine frames in a row) and the executive relocates when the UMS reports the robot lost.
     // (Seed 1 no longer gives the UMS a false match to refuse since the expectations carry the
     // landmarks' look.)
-    let world = common::repo().join("worlds/hallway.toml");
-    let mission = std::fs::read_to_string(common::repo().join("missions/ptrans.toml"))
-        .expect("ptrans")
-        .replace("seed = 1", "seed = 2")
-        .replace("../worlds/hallway.toml", world.to_str().expect("utf8"));
-    let dir = common::scratch("rosout-seed");
-    let file = dir.join("ptrans-seed2.toml");
-    std::fs::write(&file, mission).expect("written");
+    let (_dir, file) = common::at_seed(&common::repo().join("missions/ptrans.toml"), 2, "rosout-seed");
     let run = common::run_mission_processes(file.to_str().expect("utf8"), "rosout");
     assert!(run.status.success(), "{}\n{}", run.stdout, run.stderr);
     let (mut lines, mut ticks) = (Vec::new(), std::collections::BTreeSet::new());

@@ -45,6 +45,21 @@ pub fn scratch(tag: &str) -> Scratch {
     Scratch(d)
 }
 
+/// A copy of the shipped hallway mission `mission` (seed 1) at `seed`, in a scratch folder of
+/// its own (kept while the returned [`Scratch`] lives), its world's path made absolute.
+#[allow(dead_code, reason = "not every test runs another seed")]
+pub fn at_seed(mission: &Path, seed: u64, tag: &str) -> (Scratch, PathBuf) {
+    let world = repo().join("worlds/hallway.toml");
+    let text = std::fs::read_to_string(mission)
+        .expect("the mission")
+        .replace("seed = 1", &format!("seed = {seed}"))
+        .replace("../worlds/hallway.toml", world.to_str().expect("utf8"));
+    let dir = scratch(tag);
+    let file = dir.join(format!("seed{seed}.toml"));
+    std::fs::write(&file, text).expect("written");
+    (dir, file)
+}
+
 /// A scratch folder; see [`scratch`].
 pub struct Scratch(PathBuf);
 
