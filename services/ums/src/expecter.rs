@@ -3,7 +3,7 @@
 //! calibration — widened for the perceptual strategy that will look in it. For comparison, the
 //! window a disk model of the same uncertainty gives (002 Fig. 68–69).
 
-use harvey_world::{Camera, Landmark, LandmarkClass, Pose2, World, project_with};
+use harvey_world::{Camera, Landmark, LandmarkClass, project_with};
 
 use crate::geometry::Pt;
 use crate::map::{Map, wrap};
@@ -138,17 +138,6 @@ pub fn window(map: &Map, view: View<'_>, l: &Landmark, margin_px: f64) -> Option
         v1: (b[3] + margin_px).min(h),
     };
     (b[0].is_finite() && win.u0 < win.u1 && win.v0 < win.v1).then_some(win)
-}
-
-/// A class I landmark's look through `win` as the map predicts it from its centre, the pose the
-/// robot believes (`harvey_render::edge_contrast`: the step across its line in four bands of the
-/// window's rows); all 0 when the line's foot is not in front of the camera.
-pub fn look(world: &World, map: &Map, size: (u32, u32), l: &Landmark, win: &Window) -> [f32; 4] {
-    let pose = Pose2 { x_m: map.centre[0], y_m: map.centre[1], heading_rad: map.heading_rad };
-    match world.camera.project(size.0, size.1, pose, l.position_m) {
-        Some([u, _]) => harvey_render::edge_contrast(world, pose, size, u, [win.v0, win.v1]),
-        None => [0.0; 4],
-    }
 }
 
 /// The Expecter's window for the frame the vision workers will search it in, one tick after the

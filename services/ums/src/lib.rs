@@ -11,6 +11,7 @@ mod error;
 pub mod expecter;
 mod fix;
 pub mod geometry;
+pub mod look;
 pub mod map;
 pub mod mount;
 pub mod node;
@@ -346,11 +347,7 @@ impl Ums {
                     window_px: [win.u0 as f32, win.v0 as f32, win.u1 as f32, win.v1 as f32],
                     width_px: w,
                     height_px: h,
-                    contrast: if class == 1 {
-                        expecter::look(&self.world, m, (w, h), l, &win)
-                    } else {
-                        [0.0; 4]
-                    },
+                    contrast: if class == 1 { look::look(&self.world, m, (w, h), l, &win) } else { [0.0; 4] },
                 })
             })
             .collect()
