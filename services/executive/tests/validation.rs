@@ -12,7 +12,8 @@ use harvey_world::World;
 const DEFAULT: &str = include_str!("../../../missions/default.toml");
 const DOCKING: &str = include_str!("../../../missions/docking.toml");
 const POLES: &str = include_str!("../../../missions/poles.toml");
-const PTRANS: &str = include_str!("../../../missions/ptrans.toml");
+// The hand-listed form: its vertices are reached into below (`missions/ptrans.toml` selects them).
+const PTRANS: &str = include_str!("../../../missions/ptrans-listed.toml");
 const SERVOED: &str = include_str!("../../../missions/hallway-40ft.toml");
 
 /// `text` with its first `from` replaced by `to` (which must be there).
