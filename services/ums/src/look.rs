@@ -94,6 +94,9 @@ mod tests {
         // and bottom rows see other things from the two (the lintel, the baseboard, the floor).
         let (far, near) = (at(&Map::exact(1.5, 0.0, 0.0)), at(&Map::exact(3.5, 0.0, 0.0)));
         assert!(far[0] < 0.0 && near[0] > 0.0 && far[3] < 0.0 && near[3] > 0.0, "{far:?} {near:?}");
+        // The centre alone predicts a step in every band.
+        let centre = at(&Map::exact(2.5, 0.005, 0.0));
+        assert!(centre.iter().all(|&c| c != 0.0), "{centre:?}");
         // A map 2 m long down the hall (dead reckoning's along a long leg): beside the door the
         // look is kept, the top and bottom bands are not.
         let long = Map::region(&[[1.5, 0.0], [3.5, 0.0], [3.5, 0.01], [1.5, 0.01]], 0.0, 0.01, 0.01);

@@ -45,7 +45,7 @@ pub struct LineLandmarks {
     pub z: f32,
     /// An edge whose agreement with the predicted look (`Profile::agreement`, -1 to 1) is
     /// below the negative of this runs the other way from the landmark: never taken, and no
-    /// rival where the look is clear (`clear_look`).
+    /// rival where the look is clear (`clear_look`); under `faint_look` nothing is refused.
     pub contrary: f32,
     /// The least mean predicted step (reflectance, over the look's bands) for the look to be
     /// used: a tenth of the scale, 22 grey levels in full light, about the edge threshold.
@@ -148,7 +148,8 @@ impl LineLandmarks {
         // edge (a look-alike: the next door's other jamb). Where the landmark's own step is
         // predicted clear, it is neither the landmark nor its rival; beside a faint landmark
         // it stays a rival (the landmark may be too faint to see, and the look-alike left the
-        // only edge of the right polarity in the window) but is never taken.
+        // only edge of the right polarity in the window) but is never taken. Under `faint_look`
+        // there is no look to go by.
         let predicted = e.contrast.iter().map(|c| c.abs()).sum::<f32>() / e.contrast.len() as f32;
         let contrary = |profile: &Profile, k| profile.agreement(k, span, &e.contrast) < -self.contrary;
         if predicted >= self.clear_look {
