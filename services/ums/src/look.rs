@@ -26,7 +26,13 @@ pub fn look(world: &World, map: &Map, size: (u32, u32), l: &Landmark, win: &Wind
         .map(|p| Pose2 { x_m: p[0], y_m: p[1], ..centre })
         .into_iter()
         .chain([-map.cw_rad, map.ccw_rad].map(|d| Pose2 { heading_rad: map.heading_rad + d, ..centre }));
+    // A pose traced already tells nothing new (an exact map's vertices and wedge are its centre).
+    let (mut traced, mut n) = ([centre; 7], 1);
     for pose in others {
+        if traced[..n].contains(&pose) {
+            continue;
+        }
+        (traced[n], n) = (pose, n + 1);
         let other = seen(pose).unwrap_or([0.0; 4]);
         for (c, o) in look.iter_mut().zip(other) {
             if *c * o <= 0.0 {
@@ -55,10 +61,7 @@ fn extremes(map: &Map, at: [f64; 3]) -> [Pt; 4] {
 mod tests {
     use super::*;
     use crate::expecter::{View, window};
-
-    fn hallway() -> World {
-        harvey_world::load_str(include_str!("../../../worlds/hallway.toml"), "hallway").expect("hallway")
-    }
+    use crate::tests::hallway;
 
     fn landmark<'w>(w: &'w World, name: &str) -> &'w Landmark {
         w.landmarks.iter().find(|l| l.name == name).expect("landmark")
